@@ -1,0 +1,40 @@
+# Helpers that give every mmm target the same compile settings:
+# warnings as errors on our code, third-party headers as SYSTEM (imported
+# targets), optional sanitizers.
+
+function(mmm_target_settings target)
+  target_compile_options(${target} PRIVATE
+    -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast
+    -Wcast-align -Woverloaded-virtual -Wnull-dereference -Wimplicit-fallthrough
+    -Werror)
+  if(MMM_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=${MMM_SANITIZE} -fno-omit-frame-pointer
+                                             -fno-sanitize-recover=all)
+    target_link_options(${target} PRIVATE -fsanitize=${MMM_SANITIZE})
+  endif()
+endfunction()
+
+# mmm_add_library(<name> ALIAS <ns::name> [DEPS <targets>...])
+# One static library per top-level folder; sources are the .cpp files below
+# the calling folder (one algorithm per name.h/name.cpp pair).
+function(mmm_add_library name)
+  cmake_parse_arguments(ARG "" "ALIAS" "DEPS" ${ARGN})
+  file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
+  if(NOT sources)
+    # A folder whose layer has no code yet is still a target, so that the
+    # dependency direction (nodes -> workflow -> core) is fixed from the start.
+    add_library(${name} INTERFACE)
+    target_include_directories(${name} INTERFACE ${PROJECT_SOURCE_DIR})
+    target_link_libraries(${name} INTERFACE ${ARG_DEPS})
+    add_library(${ARG_ALIAS} ALIAS ${name})
+    return()
+  endif()
+  add_library(${name} STATIC ${sources})
+  target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
+  target_link_libraries(${name} PUBLIC ${ARG_DEPS})
+  mmm_target_settings(${name})
+  if(MMM_SANITIZE)
+    target_link_options(${name} INTERFACE -fsanitize=${MMM_SANITIZE})
+  endif()
+  add_library(${ARG_ALIAS} ALIAS ${name})
+endfunction()

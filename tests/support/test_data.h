@@ -1,0 +1,40 @@
+#pragma once
+// Helpers shared by the test suites: where the real data and the build live,
+// and scratch folders that clean up after themselves.
+
+#include <filesystem>
+#include <string>
+
+namespace mmm::test {
+
+// ../shared/data as configured at build time (CMake MMM_DATA_DIR). A test that
+// needs it fails (never skips) when it is missing: CI always has it beside us.
+std::filesystem::path data_dir();
+
+// The project's source and build folders.
+std::filesystem::path source_dir();
+std::filesystem::path binary_dir();
+
+// Path to build/bin/mmm, for tests that run the command line.
+std::filesystem::path mmm_executable();
+
+// A fresh empty folder under the system temp dir, removed when destroyed.
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& label);
+  ~ScratchDir();
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+  [[nodiscard]] std::filesystem::path operator/(const std::string& name) const {
+    return path_ / name;
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// Writes bytes to a file (creating parent folders); returns the path.
+std::filesystem::path write_file(const std::filesystem::path& path, const std::string& bytes);
+
+}  // namespace mmm::test
