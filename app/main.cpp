@@ -4,16 +4,18 @@
 //   2 the command line itself is wrong.
 
 #include <CLI/CLI.hpp>
-#include <cstdio>
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "app/commands/commands.h"
 #include "core/errors.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   CLI::App app{
-      "mmm - patient-specific moving musculoskeletal models of the lower limb\n"
+      "mmm - patient-specific moving musculoskeletal models of the lower limb.\n"
       "Run 'mmm COMMAND --help' for the options of a command."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("mmm ") + MMM_VERSION);
@@ -21,16 +23,26 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // Help and version requests exit 0; every other parse problem is a usage
+    // error: CLI11 prints it, we exit 2.
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  return mmm::app::exit_code();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
   } catch (const mmm::IoError& e) {
     std::cerr << "mmm: error: " << e.what() << '\n';
-    return 1;
   } catch (const mmm::InvalidInputError& e) {
     std::cerr << "mmm: invalid input: " << e.what() << '\n';
-    return 1;
   } catch (const std::exception& e) {
     std::cerr << "mmm: error: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    std::cerr << "mmm: error: unknown failure\n";
   }
-  return 0;
+  return 1;
 }

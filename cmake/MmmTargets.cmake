@@ -5,7 +5,7 @@
 function(mmm_target_settings target)
   target_compile_options(${target} PRIVATE
     -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast
-    -Wcast-align -Woverloaded-virtual -Wnull-dereference -Wimplicit-fallthrough
+    -Wcast-align -Woverloaded-virtual -Wimplicit-fallthrough
     -Werror)
   if(MMM_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=${MMM_SANITIZE} -fno-omit-frame-pointer

@@ -1,6 +1,8 @@
 #pragma once
 // Registration of the subcommand groups of the `mmm` executable. Each group
-// lives in its own file and runs its work inside CLI11 callbacks.
+// lives in its own file and does its work inside CLI11 callbacks; a callback
+// that finishes but has something to flag (e.g. a survey with unreadable
+// files) sets the exit code instead of throwing.
 
 #include <CLI/CLI.hpp>
 
@@ -8,5 +10,10 @@ namespace mmm::app {
 
 // mmm mesh info|convert|decimate|survey
 void register_mesh_commands(CLI::App& app);
+
+// Exit code requested by the command that ran (0 unless it called
+// set_exit_code).
+int exit_code();
+void set_exit_code(int code);
 
 }  // namespace mmm::app

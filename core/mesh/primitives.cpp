@@ -70,11 +70,13 @@ IndexedMesh make_icosphere(int subdivisions, double radius, const Eigen::Vector3
   return from_lists(vertices, faces);
 }
 
-IndexedMesh make_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+IndexedMesh make_box(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& max_corner) {
   std::vector<Eigen::Vector3d> vertices;
+  vertices.reserve(8);
   for (int i = 0; i < 8; ++i) {
-    vertices.emplace_back((i & 1) ? hi.x() : lo.x(), (i & 2) ? hi.y() : lo.y(),
-                          (i & 4) ? hi.z() : lo.z());
+    vertices.emplace_back((i & 1) ? max_corner.x() : min_corner.x(),
+                          (i & 2) ? max_corner.y() : min_corner.y(),
+                          (i & 4) ? max_corner.z() : min_corner.z());
   }
   // Two outward triangles per side; vertex i has bits (x, y, z).
   const std::vector<Eigen::Vector3i> faces = {
@@ -96,6 +98,8 @@ IndexedMesh make_torus(double major_radius, double minor_radius, int major_segme
   }
   std::vector<Eigen::Vector3d> vertices;
   std::vector<Eigen::Vector3i> faces;
+  vertices.reserve(static_cast<size_t>(major_segments) * static_cast<size_t>(minor_segments));
+  faces.reserve(2 * vertices.capacity());
   const double two_pi = 2.0 * std::numbers::pi;
   for (int i = 0; i < major_segments; ++i) {
     const double u = two_pi * i / major_segments;
@@ -127,6 +131,8 @@ IndexedMesh make_cylinder(double radius, double height, int segments) {
   }
   std::vector<Eigen::Vector3d> vertices;
   std::vector<Eigen::Vector3i> faces;
+  vertices.reserve(2 * static_cast<size_t>(segments) + 2);
+  faces.reserve(4 * static_cast<size_t>(segments));
   for (int ring = 0; ring < 2; ++ring) {
     for (int i = 0; i < segments; ++i) {
       const double a = 2.0 * std::numbers::pi * i / segments;

@@ -1,13 +1,14 @@
 #include "tests/support/test_data.h"
 
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <stdexcept>
 
 namespace mmm::test {
 
 std::filesystem::path data_dir() {
-  const std::filesystem::path dir = std::filesystem::weakly_canonical(MMM_DATA_DIR);
+  std::filesystem::path dir = std::filesystem::weakly_canonical(MMM_DATA_DIR);
   if (!std::filesystem::is_directory(dir / "vhf") ||
       !std::filesystem::is_directory(dir / "gait2392")) {
     throw std::runtime_error("shared data not found at " + dir.string() +
@@ -37,6 +38,12 @@ ScratchDir::ScratchDir(const std::string& label) {
 ScratchDir::~ScratchDir() {
   std::error_code ignored;
   std::filesystem::remove_all(path_, ignored);
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("could not read " + path.string());
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 std::filesystem::path write_file(const std::filesystem::path& path, const std::string& bytes) {

@@ -34,6 +34,9 @@ class ScratchDir {
   std::filesystem::path path_;
 };
 
+// Whole content of a file; throws when it cannot be read.
+std::string read_text(const std::filesystem::path& path);
+
 // Writes bytes to a file (creating parent folders); returns the path.
 std::filesystem::path write_file(const std::filesystem::path& path, const std::string& bytes);
 

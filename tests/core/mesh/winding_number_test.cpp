@@ -1,0 +1,176 @@
+#include "core/mesh/winding_number.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "core/errors.h"
+#include "core/mesh/aabb_tree.h"
+#include "core/mesh/primitives.h"
+
+namespace mmm::mesh {
+namespace {
+
+constexpr double kMajor = 10.0;
+constexpr double kMinor = 3.0;
+
+// Signed distance to the analytic torus around z (negative in the tube).
+double torus_implicit(const Eigen::Vector3d& p) {
+  const double ring = std::hypot(p.x(), p.y()) - kMajor;
+  return std::hypot(ring, p.z()) - kMinor;
+}
+
+double longest_edge(const IndexedMesh& mesh) {
+  double longest = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const double length = (mesh.V.row(mesh.F(f, k)) - mesh.V.row(mesh.F(f, (k + 1) % 3))).norm();
+      longest = std::max(longest, length);
+    }
+  }
+  return longest;
+}
+
+Eigen::Vector3d uniform_in(const Eigen::AlignedBox3d& box, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Eigen::Vector3d s(unit(rng), unit(rng), unit(rng));
+  return box.min() + s.cwiseProduct(box.sizes());
+}
+
+// A cube [-1, 1]^3 without its top face (z = 1): an open surface.
+IndexedMesh open_box() {
+  const IndexedMesh box = make_box(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1));
+  IndexedMesh open;
+  open.V = box.V;
+  open.F.resize(10, 3);
+  int kept = 0;
+  for (int f = 0; f < box.num_faces(); ++f) {
+    const bool on_top =
+        box.V(box.F(f, 0), 2) == 1 && box.V(box.F(f, 1), 2) == 1 && box.V(box.F(f, 2), 2) == 1;
+    if (!on_top) open.F.row(kept++) = box.F.row(f);
+  }
+  EXPECT_EQ(kept, 10);
+  return open;
+}
+
+TEST(WindingNumberTest, TorusTubeIsInsideHoleAndOutsideAreNot) {
+  const IndexedMesh torus = make_torus(kMajor, kMinor, 96, 48);
+  const AabbTree tree(torus);
+  const WindingNumber winding(tree);
+  EXPECT_TRUE(winding.is_inside(Eigen::Vector3d(10, 0, 0)));     // tube centre circle
+  EXPECT_TRUE(winding.is_inside(Eigen::Vector3d(0, -11.5, 1)));  // in the tube
+  EXPECT_FALSE(winding.is_inside(Eigen::Vector3d(0, 0, 0)));     // centre of the hole
+  EXPECT_FALSE(winding.is_inside(Eigen::Vector3d(5, 0, 0)));     // hole, near the tube
+  EXPECT_FALSE(winding.is_inside(Eigen::Vector3d(20, 0, 0)));    // beside
+  EXPECT_FALSE(winding.is_inside(Eigen::Vector3d(10, 0, 5)));    // above the tube
+  // Deep in the tube and far away the value itself is an integer; the far-field
+  // approximation errs by ~1e-3 (Barill et al. 2018 with beta = 2).
+  EXPECT_NEAR(winding.at(Eigen::Vector3d(10, 0, 0)), 1.0, 1e-2);
+  EXPECT_NEAR(winding.at(Eigen::Vector3d(0, 0, 0)), 0.0, 1e-2);
+  EXPECT_NEAR(winding.at(Eigen::Vector3d(100, -200, 50)), 0.0, 1e-2);
+}
+
+TEST(WindingNumberTest, TorusInsideTestMatchesImplicitFunctionAwayFromSurface) {
+  const IndexedMesh torus = make_torus(kMajor, kMinor, 96, 48);
+  const AabbTree tree(torus);
+  const WindingNumber winding(tree);
+  // The implicit distance is 1-Lipschitz and zero at every vertex, and each
+  // point of a face is within one edge length of a vertex of that face: the
+  // polyhedron lies where |implicit| <= longest edge. Beyond that band the
+  // polyhedron's inside (the winding number is constant on each side) is the
+  // analytic one.
+  const double margin = longest_edge(torus);
+  EXPECT_LT(margin, 1.0);
+  std::mt19937 rng(42);
+  const Eigen::AlignedBox3d box(Eigen::Vector3d(-15, -15, -5), Eigen::Vector3d(15, 15, 5));
+  int compared = 0;
+  int inside = 0;
+  for (int i = 0; i < 5000; ++i) {
+    const Eigen::Vector3d q = uniform_in(box, rng);
+    const double implicit = torus_implicit(q);
+    if (std::abs(implicit) <= margin) continue;
+    ++compared;
+    inside += implicit < 0 ? 1 : 0;
+    ASSERT_EQ(winding.is_inside(q), implicit < 0) << "at " << q.transpose();
+  }
+  // The sample really exercises both sides (tube ~20% of the box volume).
+  EXPECT_GT(compared, 3000);
+  EXPECT_GT(inside, 300);
+}
+
+// Largest |fast - exact| at 1000 uniform points of the mesh's box grown by
+// half its size on each side.
+double worst_fast_error(const IndexedMesh& surface, std::mt19937& rng) {
+  const AabbTree tree(surface);
+  const WindingNumber winding(tree);
+  Eigen::AlignedBox3d box = tree.bounds();
+  box.extend(box.min() - 0.5 * box.sizes()).extend(box.max() + 0.5 * box.sizes());
+  double worst = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const Eigen::Vector3d q = uniform_in(box, rng);
+    worst = std::max(worst, std::abs(winding.at(q) - winding_number_exact(surface, q)));
+  }
+  return worst;
+}
+
+TEST(WindingNumberTest, FastAgreesWithExactAtRandomPoints) {
+  std::mt19937 rng(9);
+  // Barill et al. 2018 report errors ~1e-3 for beta = 2; 1e-2 is far below
+  // what the inside test (threshold 1/2) can tolerate.
+  EXPECT_LT(worst_fast_error(make_torus(kMajor, kMinor, 64, 32), rng), 1e-2);
+  EXPECT_LT(worst_fast_error(make_icosphere(3, 4.0, Eigen::Vector3d(1, 1, 1)), rng), 1e-2);
+  EXPECT_LT(worst_fast_error(open_box(), rng), 1e-2);
+}
+
+TEST(WindingNumberTest, ClosedSphereGivesOneInsideAndZeroOutside) {
+  const IndexedMesh sphere = make_icosphere(2, 2.0);
+  // Solid angles of a closed surface sum to exactly 4 pi or 0: only rounding
+  // of 320 atan2 terms remains.
+  EXPECT_NEAR(winding_number_exact(sphere, Eigen::Vector3d(0.3, -0.2, 0.5)), 1.0, 1e-12);
+  EXPECT_NEAR(winding_number_exact(sphere, Eigen::Vector3d(3, 1, 0)), 0.0, 1e-12);
+  // Inside a face the value is the mean of the two sides: the face itself
+  // contributes 0 there and jumps by 1 across, the others are continuous.
+  const Eigen::Vector3d face_centre =
+      (sphere.V.row(sphere.F(5, 0)) + sphere.V.row(sphere.F(5, 1)) + sphere.V.row(sphere.F(5, 2)))
+          .transpose() /
+      3.0;
+  EXPECT_NEAR(winding_number_exact(sphere, face_centre), 0.5, 1e-12);
+}
+
+TEST(WindingNumberTest, OpenBoxStaysNearOneDeepInside) {
+  const IndexedMesh open = open_box();
+  const AabbTree tree(open);
+  const WindingNumber winding(tree);
+  // At the centre every side subtends 4 pi / 6: without the top w = 5/6.
+  EXPECT_NEAR(winding_number_exact(open, Eigen::Vector3d::Zero()), 5.0 / 6.0, 1e-12);
+  // Near the bottom the hole (a 2 x 2 square at height d = 1.9) subtends
+  // 4 atan(a b / (d sqrt(a^2 + b^2 + d^2))) with a = b = 1; w = 1 - that / 4 pi.
+  const Eigen::Vector3d deep(0, 0, -0.9);
+  const double d = 1.9;
+  const double hole = 4.0 * std::atan(1.0 / (d * std::sqrt(2.0 + d * d)));
+  const double expected = 1.0 - hole / (4.0 * std::numbers::pi);
+  EXPECT_GT(expected, 0.9);
+  EXPECT_NEAR(winding_number_exact(open, deep), expected, 1e-12);  // rounding of 10 terms
+  EXPECT_NEAR(winding.at(deep), expected, 1e-2);                   // far-field error, see above
+  EXPECT_TRUE(winding.is_inside(deep));
+  EXPECT_TRUE(winding.is_inside(Eigen::Vector3d(0.5, -0.5, 0)));
+  EXPECT_FALSE(winding.is_inside(Eigen::Vector3d(0, 0, 3)));  // above the hole
+  EXPECT_FALSE(winding.is_inside(Eigen::Vector3d(3, 0, 0)));
+}
+
+TEST(WindingNumberTest, RejectsInvalidInput) {
+  const AabbTree tree(make_box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 1)));
+  EXPECT_THROW(WindingNumber(tree, {.beta = 1.0}), InvalidInputError);
+  EXPECT_THROW(WindingNumber(tree, {.beta = std::nan("")}), InvalidInputError);
+  const WindingNumber winding(tree);
+  EXPECT_THROW((void)winding.at(Eigen::Vector3d::Constant(INFINITY)), InvalidInputError);
+  IndexedMesh bad = make_box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 1));
+  bad.F(0, 0) = -1;
+  EXPECT_THROW((void)winding_number_exact(bad, Eigen::Vector3d::Zero()), InvalidInputError);
+}
+
+}  // namespace
+}  // namespace mmm::mesh
