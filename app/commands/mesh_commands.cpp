@@ -1,12 +1,13 @@
 // mmm mesh info|convert|decimate|survey: the command-line face of core/mesh.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
-#include <sstream>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -74,10 +75,9 @@ struct DecimateArgs {
 void run_decimate(const DecimateArgs& args) {
   const mesh::IndexedMesh mesh = mesh::read_mesh(args.input);
   mesh::DecimateReport report;
-  const mesh::IndexedMesh coarse =
-      mesh::decimate(mesh, {.target_faces = args.faces,
-                            .max_normal_deviation_degrees = args.max_normal_deviation},
-                     &report);
+  const mesh::IndexedMesh coarse = mesh::decimate(
+      mesh, {.target_faces = args.faces, .max_normal_deviation_degrees = args.max_normal_deviation},
+      &report);
   mesh::write_mesh(coarse, args.output);
   std::cout << "wrote " << args.output << ": " << report.faces_before << " -> "
             << report.faces_after << " faces\n";
@@ -136,13 +136,17 @@ void run_survey(const SurveyArgs& args) {
       const MeshSummary summary = summarize_mesh(mesh, name);
       report.push_back(to_json(summary, kUnits));
       const auto& c = summary.check;
-      const std::string volume = summary.has_volume() ? std::to_string(summary.properties.volume)
-                                                      : std::string("n/a");
+      std::string volume = "n/a";
+      if (summary.has_volume()) {
+        std::array<char, 32> text{};
+        std::snprintf(text.data(), text.size(), "%.1f", summary.properties.volume);
+        volume = text.data();
+      }
       std::string problems;
       for (const auto& p : c.problems()) problems += (problems.empty() ? "" : "; ") + p;
-      std::printf("%-58s %7ld %7ld %-6s %14s %12.1f\n", name.c_str(),
-                  static_cast<long>(c.vertices), static_cast<long>(c.faces),
-                  c.closed() ? "yes" : "no", volume.c_str(), summary.properties.area);
+      std::printf("%-58s %7ld %7ld %-6s %14s %12.1f\n", name.c_str(), static_cast<long>(c.vertices),
+                  static_cast<long>(c.faces), c.closed() ? "yes" : "no", volume.c_str(),
+                  summary.properties.area);
       csv << csv_field(name) << ',' << c.vertices << ',' << c.faces << ',' << c.closed() << ','
           << c.watertight() << ',' << volume << ',' << summary.properties.area << ','
           << c.connected_components << ',' << csv_field(problems) << '\n';
@@ -160,12 +164,11 @@ void run_survey(const SurveyArgs& args) {
       ++failures;
       std::printf("%-58s FAILED: %s\n", name.c_str(), e.what());
       report.push_back({{"file", name}, {"error", e.what()}});
-      csv << csv_field(name) << ",,,,,,,," << csv_field(std::string("FAILED: ") + e.what())
-          << '\n';
+      csv << csv_field(name) << ",,,,,,,," << csv_field(std::string("FAILED: ") + e.what()) << '\n';
     }
   }
-  std::printf("%zu meshes, %d unreadable; volume in %s^3, area in %s^2\n", files.size(),
-              failures, kUnits, kUnits);
+  std::printf("%zu meshes, %d unreadable; volume in %s^3, area in %s^2\n", files.size(), failures,
+              kUnits, kUnits);
   if (!out.empty()) {
     std::ofstream(out / "survey.json") << report.dump(2) << '\n';
     std::ofstream(out / "survey.csv") << csv.str();
@@ -185,8 +188,7 @@ void register_mesh_commands(CLI::App& app) {
   auto info_args = std::make_shared<InfoArgs>();
   auto* info = mesh->add_subcommand(
       "info", "Health report (closedness, manifoldness, orientation) and measures of one mesh");
-  info->add_option("FILE", info_args->file, "Mesh file (.stl .obj .ply .off .vtp)")
-      ->required();
+  info->add_option("FILE", info_args->file, "Mesh file (.stl .obj .ply .off .vtp)")->required();
   info->add_flag("--json", info_args->json, "Print JSON instead of text");
   info->add_option("--scale", info_args->scale,
                    "Multiply coordinates to get mm (1000 for files in metres)");
@@ -208,8 +210,9 @@ void register_mesh_commands(CLI::App& app) {
   decimate->add_option("--faces", decimate_args->faces, "Target face count")
       ->required()
       ->check(CLI::Range(Eigen::Index{4}, Eigen::Index{1} << 40));
-  decimate->add_option("--max-normal-deviation", decimate_args->max_normal_deviation,
-                       "Largest normal change per collapse (degrees)")
+  decimate
+      ->add_option("--max-normal-deviation", decimate_args->max_normal_deviation,
+                   "Largest normal change per collapse (degrees)")
       ->check(CLI::Range(1.0, 180.0));
   decimate->callback([decimate_args] { run_decimate(*decimate_args); });
 

@@ -6,7 +6,9 @@
 namespace mmm::app {
 namespace {
 
-nlohmann::json vec(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+nlohmann::json vec(const Eigen::Vector3d& v) {
+  return nlohmann::json::array({v.x(), v.y(), v.z()});
+}
 
 std::string fmt(double value, int precision = 3) {
   std::ostringstream out;
@@ -61,13 +63,13 @@ nlohmann::json to_json(const MeshSummary& s, const std::string& units) {
   out["area"] = s.properties.area;
   out["centroid"] = vec(s.properties.centroid);
   out["centroid_of"] = s.has_volume() ? "solid" : "surface";
-  out["bounding_box"] = {{"min", vec(s.bounds.min())},
-                         {"max", vec(s.bounds.max())},
-                         {"size", vec(s.bounds.sizes())}};
+  out["bounding_box"] = {
+      {"min", vec(s.bounds.min())}, {"max", vec(s.bounds.max())}, {"size", vec(s.bounds.sizes())}};
   const mesh::OrientedBox& box = s.oriented_box;
-  out["oriented_box"] = {{"center", vec(box.center)},
-                         {"axes", {vec(box.axes.col(0)), vec(box.axes.col(1)), vec(box.axes.col(2))}},
-                         {"half_extents", vec(box.half_extents)}};
+  out["oriented_box"] = {
+      {"center", vec(box.center)},
+      {"axes", {vec(box.axes.col(0)), vec(box.axes.col(1)), vec(box.axes.col(2))}},
+      {"half_extents", vec(box.half_extents)}};
   return out;
 }
 
@@ -80,8 +82,8 @@ std::string to_text(const MeshSummary& s, const std::string& units) {
   out << "size        " << c.vertices << " vertices, " << c.faces << " faces, " << c.edges
       << " edges, " << c.connected_components << " component(s), Euler characteristic "
       << c.euler_characteristic << '\n';
-  out << "closed      " << (c.closed() ? "yes" : "no") << "  (watertight: "
-      << (c.watertight() ? "yes" : "no") << ")\n";
+  out << "closed      " << (c.closed() ? "yes" : "no")
+      << "  (watertight: " << (c.watertight() ? "yes" : "no") << ")\n";
   const auto problems = c.problems();
   if (problems.empty()) {
     out << "problems    none\n";

@@ -12,8 +12,8 @@
 namespace mmm::mesh {
 namespace {
 
-// Traversal stacks hold at most one entry per level (closest point, first hit)
-// or two (winding number elsewhere); the median split bounds the depth by
+// Traversal stacks hold at most one pending entry per level (closest point,
+// first hit) or two (all hits); the median split bounds the depth by
 // ceil(log2 #F) <= 31 for any int-indexed mesh.
 constexpr int kStackSize = 64;
 
@@ -79,7 +79,8 @@ int build_node(BuildState& state, int begin, int end, int depth) {
 
   Eigen::AlignedBox3d centroid_box;
   for (int i = begin; i < end; ++i) {
-    centroid_box.extend((*state.centroids)[static_cast<size_t>((*state.order)[static_cast<size_t>(i)])]);
+    centroid_box.extend(
+        (*state.centroids)[static_cast<size_t>((*state.order)[static_cast<size_t>(i)])]);
   }
   Eigen::Index axis = 0;
   centroid_box.sizes().maxCoeff(&axis);
@@ -199,8 +200,8 @@ double closest_on_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& ab,
 struct Ray {
   Eigen::Vector3d origin;
   Eigen::Vector3d direction;
-  Eigen::Vector3d inverse;          // 1 / direction where finite
-  std::array<bool, 3> parallel{};   // direction component 0 (or subnormal)
+  Eigen::Vector3d inverse;         // 1 / direction where finite
+  std::array<bool, 3> parallel{};  // direction component 0 (or subnormal)
   double direction_squared_norm = 0;
 };
 
@@ -270,9 +271,9 @@ bool ray_triangle(const Ray& ray, const Eigen::Vector3d& a, const Eigen::Vector3
 
 }  // namespace
 
-AabbTree::AabbTree(const IndexedMesh& mesh) : AabbTree(mesh, Options{}) {}
+AabbTree::AabbTree(IndexedMesh mesh) : AabbTree(std::move(mesh), Options{}) {}
 
-AabbTree::AabbTree(const IndexedMesh& mesh, const Options& options) : mesh_(mesh) {
+AabbTree::AabbTree(IndexedMesh mesh, const Options& options) : mesh_(std::move(mesh)) {
   if (options.max_leaf_size < 1) {
     throw InvalidInputError("AabbTree: max_leaf_size must be at least 1, got " +
                             std::to_string(options.max_leaf_size));
@@ -291,10 +292,10 @@ void AabbTree::build(const Options& options) {
   std::vector<Eigen::Vector3d> centroids(num_faces);
   for (size_t f = 0; f < num_faces; ++f) {
     const auto row = static_cast<Eigen::Index>(f);
-    centroids[f] = (mesh_.V.row(mesh_.F(row, 0)) + mesh_.V.row(mesh_.F(row, 1)) +
-                    mesh_.V.row(mesh_.F(row, 2)))
-                       .transpose() /
-                   3.0;
+    centroids[f] =
+        (mesh_.V.row(mesh_.F(row, 0)) + mesh_.V.row(mesh_.F(row, 1)) + mesh_.V.row(mesh_.F(row, 2)))
+            .transpose() /
+        3.0;
   }
   face_order_.resize(num_faces);
   for (size_t f = 0; f < num_faces; ++f) face_order_[f] = static_cast<int>(f);
@@ -365,8 +366,7 @@ void AabbTree::build_compact() {
   }
 }
 
-AabbTree::ClosestPoint AabbTree::search_closest(const Eigen::Vector3d& query,
-                                                double bound) const {
+AabbTree::ClosestPoint AabbTree::search_closest(const Eigen::Vector3d& query, double bound) const {
   struct Entry {
     int code;  // pair index, or ~leaf index
     double squared_distance;
@@ -382,7 +382,8 @@ AabbTree::ClosestPoint AabbTree::search_closest(const Eigen::Vector3d& query,
   bool active = box_squared_distance(nodes_.front().box, query) < best;
   while (active) {
     if (code < 0) {
-      const auto leaf = static_cast<size_t>(~code);
+      const int leaf_index = ~code;
+      const auto leaf = static_cast<size_t>(leaf_index);
       for (int i = leaf_start_[leaf]; i < leaf_start_[leaf + 1]; ++i) {
         const std::array<int, 3>& corners = corners_[static_cast<size_t>(i)];
         const Eigen::Vector3d& a = points_[static_cast<size_t>(corners[0])];
@@ -407,9 +408,8 @@ AabbTree::ClosestPoint AabbTree::search_closest(const Eigen::Vector3d& query,
       Eigen::Array2d sum = Eigen::Array2d::Zero();
       for (size_t k = 0; k < 3; ++k) {
         const double q = query[static_cast<Eigen::Index>(k)];
-        const Eigen::Array2d gap = (pair.lo[k].cast<double>() - q)
-                                       .max(q - pair.hi[k].cast<double>())
-                                       .max(0.0);
+        const Eigen::Array2d gap =
+            (pair.lo[k].cast<double>() - q).max(q - pair.hi[k].cast<double>()).max(0.0);
         sum += gap * gap;
       }
       const Eigen::Index near = sum[1] < sum[0] ? 1 : 0;
@@ -558,7 +558,8 @@ std::vector<AabbTree::RayHit> AabbTree::all_hits(const Eigen::Vector3d& origin,
   const Ray ray = make_ray(origin, direction);
   std::array<int, kStackSize> stack{};
   int top = 0;
-  if (ray_box_entry(ray, nodes_.front().box, box_pad_, t_max)) stack[static_cast<size_t>(top++)] = 0;
+  if (ray_box_entry(ray, nodes_.front().box, box_pad_, t_max))
+    stack[static_cast<size_t>(top++)] = 0;
   while (top > 0) {
     const Node& current = nodes_[static_cast<size_t>(stack[static_cast<size_t>(--top)])];
     if (current.is_leaf()) {
@@ -570,7 +571,8 @@ std::vector<AabbTree::RayHit> AabbTree::all_hits(const Eigen::Vector3d& origin,
         double v = 0;
         if (ray_triangle(ray, a, points_[static_cast<size_t>(corners[1])] - a,
                          points_[static_cast<size_t>(corners[2])] - a, t_max, t, u, v)) {
-          hits.push_back({t, face_order_[static_cast<size_t>(i)], Eigen::Vector3d(1 - u - v, u, v)});
+          hits.push_back(
+              {t, face_order_[static_cast<size_t>(i)], Eigen::Vector3d(1 - u - v, u, v)});
         }
       }
       continue;
@@ -589,8 +591,8 @@ std::vector<AabbTree::RayHit> AabbTree::all_hits(const Eigen::Vector3d& origin,
   // Merge the faces around a shared edge or vertex crossed by the ray. Within a
   // run of hits at the same point, a hit is dropped when it shares a vertex
   // with a hit already kept in that run.
-  const double same_t = kSameHitTolerance * bounds().diagonal().norm() /
-                        std::sqrt(ray.direction_squared_norm);
+  const double same_t =
+      kSameHitTolerance * bounds().diagonal().norm() / std::sqrt(ray.direction_squared_norm);
   std::vector<RayHit> merged;
   merged.reserve(hits.size());
   size_t run_start = 0;

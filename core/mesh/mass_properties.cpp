@@ -97,9 +97,9 @@ MassProperties mass_properties(const IndexedMesh& mesh) {
     const double area = 0.5 * (b - a).cross(c - a).norm();
     out.area += area;
     area_moment += area / 3.0 * (a + b + c);
-    area_covariance +=
-        area / 12.0 * (a * a.transpose() + b * b.transpose() + c * c.transpose() +
-                       (a + b + c) * (a + b + c).transpose());
+    area_covariance += area / 12.0 *
+                       (a * a.transpose() + b * b.transpose() + c * c.transpose() +
+                        (a + b + c) * (a + b + c).transpose());
   }
   out.volume = volume;
 
@@ -115,8 +115,8 @@ MassProperties mass_properties(const IndexedMesh& mesh) {
     about_centroid = (volume_covariance - volume * c * c.transpose()) * (volume < 0 ? -1.0 : 1.0);
     out.centroid = origin + c;
   } else {
-    const Eigen::Vector3d c = out.area > 0 ? Eigen::Vector3d(area_moment / out.area)
-                                           : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d c =
+        out.area > 0 ? Eigen::Vector3d(area_moment / out.area) : Eigen::Vector3d::Zero();
     about_centroid = area_covariance - out.area * c * c.transpose();
     out.centroid = origin + c;
   }

@@ -117,8 +117,8 @@ MeshCheckReport check_mesh(const IndexedMesh& mesh, const MeshCheckOptions& opti
     const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0));
     const Eigen::Vector3d b = mesh.V.row(mesh.F(f, 1));
     const Eigen::Vector3d c = mesh.V.row(mesh.F(f, 2));
-    const bool repeated =
-        mesh.F(f, 0) == mesh.F(f, 1) || mesh.F(f, 1) == mesh.F(f, 2) || mesh.F(f, 0) == mesh.F(f, 2);
+    const bool repeated = mesh.F(f, 0) == mesh.F(f, 1) || mesh.F(f, 1) == mesh.F(f, 2) ||
+                          mesh.F(f, 0) == mesh.F(f, 2);
     if (repeated || 0.5 * (b - a).cross(c - a).norm() <= min_area) ++report.degenerate_faces;
   }
 

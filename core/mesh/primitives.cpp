@@ -33,22 +33,22 @@ IndexedMesh make_icosphere(int subdivisions, double radius, const Eigen::Vector3
                             std::to_string(subdivisions));
   }
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> vertices = {
-      {-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-      {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Eigen::Vector3d> vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                           {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                           {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
   for (auto& v : vertices) v.normalize();
   std::vector<Eigen::Vector3i> faces = {
-      {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
       {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-      {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+      {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (int level = 0; level < subdivisions; ++level) {
     std::map<std::pair<int, int>, int> midpoint_of;
     auto midpoint = [&](int a, int b) {
       const auto key = std::minmax(a, b);
       const auto it = midpoint_of.find(key);
       if (it != midpoint_of.end()) return it->second;
-      vertices.push_back((vertices[static_cast<size_t>(a)] + vertices[static_cast<size_t>(b)])
-                             .normalized());
+      vertices.push_back(
+          (vertices[static_cast<size_t>(a)] + vertices[static_cast<size_t>(b)]).normalized());
       const int index = static_cast<int>(vertices.size()) - 1;
       midpoint_of.emplace(key, index);
       return index;
@@ -79,13 +79,12 @@ IndexedMesh make_box(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& m
                           (i & 4) ? max_corner.z() : min_corner.z());
   }
   // Two outward triangles per side; vertex i has bits (x, y, z).
-  const std::vector<Eigen::Vector3i> faces = {
-      {0, 2, 3}, {0, 3, 1},  // z = lo
-      {4, 5, 7}, {4, 7, 6},  // z = hi
-      {0, 1, 5}, {0, 5, 4},  // y = lo
-      {2, 6, 7}, {2, 7, 3},  // y = hi
-      {0, 4, 6}, {0, 6, 2},  // x = lo
-      {1, 3, 7}, {1, 7, 5}};  // x = hi
+  const std::vector<Eigen::Vector3i> faces = {{0, 2, 3}, {0, 3, 1},   // z = lo
+                                              {4, 5, 7}, {4, 7, 6},   // z = hi
+                                              {0, 1, 5}, {0, 5, 4},   // y = lo
+                                              {2, 6, 7}, {2, 7, 3},   // y = hi
+                                              {0, 4, 6}, {0, 6, 2},   // x = lo
+                                              {1, 3, 7}, {1, 7, 5}};  // x = hi
   return from_lists(vertices, faces);
 }
 

@@ -36,8 +36,8 @@ class SignedDistance {
   // Any 3-vector expression (Vector3d::Zero(), p + offset, ...): without this
   // it would convert to both overloads and be ambiguous.
   template <typename Derived>
-    requires(Derived::RowsAtCompileTime == 3 && Derived::ColsAtCompileTime == 1)
-  [[nodiscard]] double at(const Eigen::MatrixBase<Derived>& q) const {
+  requires(Derived::RowsAtCompileTime == 3 && Derived::ColsAtCompileTime == 1)
+      [[nodiscard]] double at(const Eigen::MatrixBase<Derived>& q) const {
     return at(Eigen::Vector3d(q));
   }
 

@@ -31,7 +31,8 @@ CommandResult run_mmm(const std::string& arguments) {
   CommandResult result;
   std::array<char, 4096> buffer{};
   size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), n);
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    result.output.append(buffer.data(), n);
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
@@ -84,7 +85,8 @@ TEST(MeshCliTest, ConvertWritesAReadableFileInMillimetres) {
   const mesh::IndexedMesh converted = mesh::read_mesh(out);
   EXPECT_EQ(converted.num_faces(), 908);
   // A femur is 350-500 mm long; in metres it would be below 1.
-  const double length = (converted.V.colwise().maxCoeff() - converted.V.colwise().minCoeff()).maxCoeff();
+  const double length =
+      (converted.V.colwise().maxCoeff() - converted.V.colwise().minCoeff()).maxCoeff();
   EXPECT_GT(length, 350.0);
   EXPECT_LT(length, 500.0);
 }
@@ -92,8 +94,8 @@ TEST(MeshCliTest, ConvertWritesAReadableFileInMillimetres) {
 TEST(MeshCliTest, SurveyOfGait2392WritesReportAndVtpCopies) {
   const test::ScratchDir dir("cli-survey");
   const auto geometry = test::data_dir() / "gait2392/Geometry";
-  const CommandResult result = run_mmm("mesh survey " + geometry.string() +
-                                       " --scale 1000 --out " + dir.path().string());
+  const CommandResult result =
+      run_mmm("mesh survey " + geometry.string() + " --scale 1000 --out " + dir.path().string());
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const auto json = nlohmann::json::parse(test::read_text(dir / "survey.json"));
   ASSERT_EQ(json.size(), 10U);  // the ten .vtp files of the model

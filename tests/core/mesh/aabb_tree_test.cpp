@@ -9,7 +9,9 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/mesh/io/mesh_io.h"
 #include "core/mesh/primitives.h"
+#include "tests/support/test_data.h"
 
 namespace mmm::mesh {
 namespace {
@@ -328,6 +330,24 @@ TEST(AabbTreeTest, RayToSphereCentreHitsAtDistanceMinusRadius) {
     EXPECT_GE(hits[1].t * speed, distance + radius - gap - 1e-9);
     EXPECT_LE(hits[1].t * speed, distance + radius + 1e-9);
   }
+}
+
+IndexedMesh gluteus_medius() {
+  return read_mesh(test::data_dir() / "vhf" / "Right" /
+                   "VHF_Right_Muscle_GluteusMedius_smooth.stl");
+}
+
+TEST(AabbTreeTest, GluteusMediusClosestPointsMatchBruteForce) {
+  const IndexedMesh muscle = gluteus_medius();
+  ASSERT_GT(muscle.num_faces(), 10000);
+  Eigen::AlignedBox3d box;
+  for (Eigen::Index v = 0; v < muscle.num_vertices(); ++v) box.extend(muscle.V.row(v).transpose());
+  // Queries through the muscle's box grown by a fifth on each side: inside,
+  // near and away from the surface (~100-170 mm boxes, coordinates ~1000 mm,
+  // still far inside the 1e-12 relative rounding argument above).
+  const Eigen::Vector3d margin = 0.2 * box.sizes();
+  expect_closest_points_match(muscle, Eigen::AlignedBox3d(box.min() - margin, box.max() + margin),
+                              200, 23);
 }
 
 }  // namespace
