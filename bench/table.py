@@ -7,15 +7,18 @@ import json
 import sys
 
 
-def main(suite, raw_path, out_path):
+def main(suite, raw_path, out_path, build_type="unknown"):
     with open(raw_path, encoding="utf-8") as f:
         raw = json.load(f)
     rows = {}
     for b in raw["benchmarks"]:
-        name = b["run_name"]
+        # "/iterations:1" only says each repetition is one batch: not a name.
+        name = b["run_name"].replace("/iterations:1", "")
         row = rows.setdefault(name, {"benchmark": name})
         aggregate = b.get("aggregate_name")
-        if aggregate == "median":
+        # One repetition has no aggregates: its single run is the median.
+        single = b.get("run_type") == "iteration" and "median_time" not in row
+        if aggregate == "median" or single:
             row["median_time"] = b["real_time"]
             row["unit"] = b["time_unit"]
             if "items_per_second" in b:
@@ -30,18 +33,20 @@ def main(suite, raw_path, out_path):
     table = list(rows.values())
     context = raw["context"]
     header = (f"suite {suite}: medians of {table[0]['repetitions'] if table else 0} repetitions, "
-              f"{context.get('num_cpus')} CPUs, build {context.get('library_build_type')}")
+              f"{context.get('num_cpus')} CPUs, mmm built {build_type}, "
+              f"load average {', '.join(f'{x:.1f}' for x in context.get('load_avg', []))}")
     print(header)
-    print(f"{'benchmark':<28} {'median':>12} {'cv%':>6} {'items/s':>14} {'ns/item':>10}")
+    print(f"{'benchmark':<24} {'median':>12} {'cv%':>6} {'items/s':>14} {'ns/item':>10}")
     for r in table:
         items = f"{r['items_per_second']:.3e}" if "items_per_second" in r else "-"
         per_item = f"{r['ns_per_item']:.1f}" if "ns_per_item" in r else "-"
-        print(f"{r['benchmark']:<28} {r['median_time']:>9.3f} {r['unit']:<2} "
+        print(f"{r['benchmark']:<24} {r['median_time']:>9.3f} {r['unit']:<2} "
               f"{r.get('cv_percent', 0):>6.1f} {items:>14} {per_item:>10}")
     with open(out_path, "w", encoding="utf-8") as f:
-        json.dump({"suite": suite, "context": context, "results": table}, f, indent=2)
+        json.dump({"suite": suite, "build_type": build_type, "context": context,
+                   "results": table}, f, indent=2)
     print(f"written {out_path}")
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:4])
+    main(*sys.argv[1:5])
