@@ -10,25 +10,12 @@
 
 #include "core/errors.h"
 #include "core/mesh/mesh.h"
+#include "core/mesh/triangle.h"
 
 namespace mmm::mesh {
 namespace {
 
 using Triplet = Eigen::Triplet<double>;
-
-// True when twice the area of triangle (p[0], p[1], p[2]) is below what rounding
-// can tell from zero. The edge vectors carry an absolute error of about
-// eps * |p| (coordinates far from the origin lose low bits), so the cross
-// product is only known to about eps * longest * (longest + |p|); eight ulps
-// of that is "zero area".
-bool is_degenerate(const std::array<Eigen::Vector3d, 3>& p, double double_area) {
-  const double longest = std::sqrt(std::max(
-      {(p[1] - p[0]).squaredNorm(), (p[2] - p[1]).squaredNorm(), (p[0] - p[2]).squaredNorm()}));
-  const double magnitude = std::max(
-      {p[0].cwiseAbs().maxCoeff(), p[1].cwiseAbs().maxCoeff(), p[2].cwiseAbs().maxCoeff()});
-  return double_area <=
-         8.0 * std::numeric_limits<double>::epsilon() * longest * (longest + magnitude);
-}
 
 }  // namespace
 
@@ -41,7 +28,7 @@ Eigen::SparseMatrix<double> cotangent_laplacian(const Eigen::MatrixX3d& V,
     const std::array<Eigen::Vector3d, 3> p = {
         V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose()};
     const double double_area = (p[1] - p[0]).cross(p[2] - p[0]).norm();
-    if (is_degenerate(p, double_area)) continue;
+    if (is_numerically_degenerate(p, double_area)) continue;
     for (int k = 0; k < 3; ++k) {
       // Corner k sees the edge (i, j) opposite to it under the angle theta_k;
       // cot theta_k = (u . v) / |u x v| with |u x v| = twice the area.

@@ -8,21 +8,10 @@
 #include <vector>
 
 #include "core/mesh/mesh.h"
+#include "core/mesh/triangle.h"
 
 namespace mmm::mesh {
 namespace {
-
-// Same degeneracy test as the cotangent Laplacian (laplacian.cpp): twice the
-// area below the rounding error of the cross product, whose edge vectors are
-// known to about eps * |p|.
-bool is_degenerate(const std::array<Eigen::Vector3d, 3>& p, double double_area) {
-  const double longest = std::sqrt(std::max(
-      {(p[1] - p[0]).squaredNorm(), (p[2] - p[1]).squaredNorm(), (p[0] - p[2]).squaredNorm()}));
-  const double magnitude = std::max(
-      {p[0].cwiseAbs().maxCoeff(), p[1].cwiseAbs().maxCoeff(), p[2].cwiseAbs().maxCoeff()});
-  return double_area <=
-         8.0 * std::numeric_limits<double>::epsilon() * longest * (longest + magnitude);
-}
 
 // Shares of one non-degenerate triangle's area for corners 0, 1, 2.
 std::array<double, 3> voronoi_shares(const std::array<Eigen::Vector3d, 3>& p, double area) {
@@ -62,7 +51,7 @@ Eigen::SparseMatrix<double> mass_matrix(const Eigen::MatrixX3d& V, const Eigen::
     const std::array<Eigen::Vector3d, 3> p = {
         V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose()};
     const double double_area = (p[1] - p[0]).cross(p[2] - p[0]).norm();
-    if (is_degenerate(p, double_area)) continue;
+    if (is_numerically_degenerate(p, double_area)) continue;
     const double area = 0.5 * double_area;
     std::array<double, 3> shares{};
     if (type == MassType::kBarycentric) {

@@ -176,6 +176,26 @@ void append_number(std::string& out, std::int64_t value) {
   out.append(buffer.data(), result.ptr);
 }
 
+void append_vertex_and_face_lines(std::string& out, const IndexedMesh& mesh) {
+  out.reserve(out.size() + static_cast<std::size_t>(mesh.V.rows()) * 64 +
+              static_cast<std::size_t>(mesh.F.rows()) * 24);
+  for (Eigen::Index v = 0; v < mesh.V.rows(); ++v) {
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      if (k > 0) out += ' ';
+      append_number(out, mesh.V(v, k));
+    }
+    out += '\n';
+  }
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    out += '3';
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      out += ' ';
+      append_number(out, static_cast<std::int64_t>(mesh.F(f, k)));
+    }
+    out += '\n';
+  }
+}
+
 bool parse_double(std::string_view token, double& value) {
   const char* first = token.data();
   const char* last = token.data() + token.size();

@@ -56,6 +56,10 @@ void append_number(std::string& out, double value);
 void append_number(std::string& out, float value);
 void append_number(std::string& out, std::int64_t value);
 
+// The text body shared by OFF and ASCII PLY: one "x y z" line per vertex,
+// then one "3 a b c" line per face.
+void append_vertex_and_face_lines(std::string& out, const IndexedMesh& mesh);
+
 // Whole-token parsing (a leading '+' is accepted). False when the token is not
 // entirely a number or is out of the type's range. "nan"/"inf" parse as doubles
 // (callers check finiteness to give a precise message).

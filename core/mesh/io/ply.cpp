@@ -485,23 +485,7 @@ void write_ply(const IndexedMesh& mesh, const std::filesystem::path& path,
   io_detail::check_mesh_for_writing(mesh, path);
   std::string out = header_text(mesh, options.ascii);
   if (options.ascii) {
-    out.reserve(out.size() + static_cast<std::size_t>(mesh.V.rows()) * 64 +
-                static_cast<std::size_t>(mesh.F.rows()) * 24);
-    for (Eigen::Index v = 0; v < mesh.V.rows(); ++v) {
-      for (Eigen::Index k = 0; k < 3; ++k) {
-        if (k > 0) out += ' ';
-        io_detail::append_number(out, mesh.V(v, k));
-      }
-      out += '\n';
-    }
-    for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-      out += '3';
-      for (Eigen::Index k = 0; k < 3; ++k) {
-        out += ' ';
-        io_detail::append_number(out, static_cast<std::int64_t>(mesh.F(f, k)));
-      }
-      out += '\n';
-    }
+    io_detail::append_vertex_and_face_lines(out, mesh);
   } else {
     const bool swap = io_detail::needs_swap(std::endian::little);
     out.reserve(out.size() + static_cast<std::size_t>(mesh.V.rows()) * 24 +

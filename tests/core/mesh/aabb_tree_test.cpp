@@ -11,6 +11,7 @@
 #include "core/errors.h"
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/primitives.h"
+#include "tests/core/mesh/mesh_test_helpers.h"
 #include "tests/support/test_data.h"
 
 namespace mmm::mesh {
@@ -54,20 +55,6 @@ double brute_force_squared_distance(const IndexedMesh& mesh, const Eigen::Vector
   return best;
 }
 
-// Largest gap between a sphere of radius `radius` around `center` and the
-// inscribed icosphere: radius minus the smallest distance from the centre to
-// a face plane (the foot of that perpendicular is the face's circumcentre,
-// inside the acute icosphere faces, so this is the exact gap).
-double icosphere_gap(const IndexedMesh& sphere, double radius, const Eigen::Vector3d& center) {
-  double nearest_plane = radius;
-  for (int f = 0; f < sphere.num_faces(); ++f) {
-    const Eigen::Vector3d a = vertex(sphere, f, 0);
-    const Eigen::Vector3d n =
-        (vertex(sphere, f, 1) - a).cross(vertex(sphere, f, 2) - a).normalized();
-    nearest_plane = std::min(nearest_plane, n.dot(a - center));
-  }
-  return radius - nearest_plane;
-}
 
 Eigen::Vector3d uniform_in(const Eigen::AlignedBox3d& box, std::mt19937& rng) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -307,7 +294,7 @@ TEST(AabbTreeTest, RayToSphereCentreHitsAtDistanceMinusRadius) {
   // The polyhedron lies between radius - gap and radius from the centre, so a
   // ray towards the centre enters at a distance in [d - r, d - r + gap] and
   // leaves at [d + r - gap, d + r].
-  const double gap = icosphere_gap(sphere, radius, center);
+  const double gap = test::icosphere_gap(sphere, radius, center);
   EXPECT_LT(gap, 0.02);  // edge ~0.66 mm: gap ~ edge^2 / (6 r) ~ 7e-3 mm
   std::mt19937 rng(17);
   std::normal_distribution<double> normal(0.0, 1.0);

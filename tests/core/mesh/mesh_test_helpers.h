@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <random>
@@ -126,6 +127,25 @@ inline double mean_edge_length(const mesh::IndexedMesh& mesh) {
     sum += (mesh.V.row(edge.first) - mesh.V.row(edge.second)).norm();
   }
   return counts.empty() ? 0.0 : sum / static_cast<double>(counts.size());
+}
+
+// Largest gap between the sphere of radius `radius` around `center` and an
+// inscribed icosphere: radius minus the smallest distance from the centre to a
+// face plane. All vertices lie on the sphere, so the foot of the perpendicular
+// from the centre to a face plane is the face's circumcentre, which is inside
+// the (acute) icosphere faces: the nearest point of the polyhedron to the centre
+// is such a foot. For an equilateral face of edge e this gap is about
+// e^2 / (6 radius).
+inline double icosphere_gap(const mesh::IndexedMesh& sphere, double radius,
+                            const Eigen::Vector3d& center) {
+  double nearest_plane = radius;
+  for (Eigen::Index f = 0; f < sphere.num_faces(); ++f) {
+    const Eigen::Vector3d a = sphere.V.row(sphere.F(f, 0)).transpose();
+    const Eigen::Vector3d b = sphere.V.row(sphere.F(f, 1)).transpose();
+    const Eigen::Vector3d c = sphere.V.row(sphere.F(f, 2)).transpose();
+    nearest_plane = std::min(nearest_plane, (b - a).cross(c - a).normalized().dot(a - center));
+  }
+  return radius - nearest_plane;
 }
 
 }  // namespace mmm::test

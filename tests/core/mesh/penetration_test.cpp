@@ -7,22 +7,11 @@
 
 #include "core/errors.h"
 #include "core/mesh/primitives.h"
+#include "tests/core/mesh/mesh_test_helpers.h"
 
 namespace mmm::mesh {
 namespace {
 
-// Largest gap between a sphere and its inscribed icosphere (see
-// signed_distance_test.cpp): radius minus the nearest face plane.
-double icosphere_gap(const IndexedMesh& sphere, double radius, const Eigen::Vector3d& center) {
-  double nearest_plane = radius;
-  for (int f = 0; f < sphere.num_faces(); ++f) {
-    const Eigen::Vector3d a = sphere.V.row(sphere.F(f, 0)).transpose();
-    const Eigen::Vector3d b = sphere.V.row(sphere.F(f, 1)).transpose();
-    const Eigen::Vector3d c = sphere.V.row(sphere.F(f, 2)).transpose();
-    nearest_plane = std::min(nearest_plane, (b - a).cross(c - a).normalized().dot(a - center));
-  }
-  return radius - nearest_plane;
-}
 
 TEST(PenetrationTest, OverlappingSpheresPenetrateByHalfTheirRadius) {
   const double radius = 10.0;
@@ -34,7 +23,7 @@ TEST(PenetrationTest, OverlappingSpheresPenetrateByHalfTheirRadius) {
   // is 5 mm from B's centre; B's polyhedron lies between radius - gap and
   // radius from that centre, so its depth is in [5 - gap, 5], and no vertex of
   // A (all on a sphere) is deeper than 5.
-  const double gap = icosphere_gap(b, radius, center_b);
+  const double gap = test::icosphere_gap(b, radius, center_b);
   EXPECT_LT(gap, 0.02);  // subdivision 4: edge ~0.7 mm, gap ~ edge^2 / 60 mm
   EXPECT_GT(report.vertices_inside, 0);
   EXPECT_EQ(report.vertices_inside, static_cast<int>(report.inside_vertices.size()));

@@ -9,28 +9,11 @@
 
 #include "core/errors.h"
 #include "core/mesh/primitives.h"
+#include "tests/core/mesh/mesh_test_helpers.h"
 
 namespace mmm::mesh {
 namespace {
 
-// Largest gap between the sphere of radius `radius` around `center` and the
-// inscribed icosphere: radius minus the smallest distance from the centre to a
-// face plane. All vertices lie on the sphere, so the foot of the perpendicular
-// from the centre to a face plane is the face's circumcentre, which is inside
-// the (acute) icosphere faces: the nearest point of the polyhedron to the centre
-// is such a foot. For an equilateral face of edge e this gap is about
-// e^2 / (6 radius); subdivision 5 of a 10 mm sphere has e ~ 0.33-0.4 mm, so
-// the gap is ~2-3e-3 mm (the largest faces sit at the old icosahedron centres).
-double icosphere_gap(const IndexedMesh& sphere, double radius, const Eigen::Vector3d& center) {
-  double nearest_plane = radius;
-  for (int f = 0; f < sphere.num_faces(); ++f) {
-    const Eigen::Vector3d a = sphere.V.row(sphere.F(f, 0)).transpose();
-    const Eigen::Vector3d b = sphere.V.row(sphere.F(f, 1)).transpose();
-    const Eigen::Vector3d c = sphere.V.row(sphere.F(f, 2)).transpose();
-    nearest_plane = std::min(nearest_plane, (b - a).cross(c - a).normalized().dot(a - center));
-  }
-  return radius - nearest_plane;
-}
 
 Eigen::Vector3d random_direction(std::mt19937& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -43,7 +26,7 @@ TEST(SignedDistanceTest, IcosphereMatchesDistanceToSphere) {
   const SignedDistance distance(sphere);
   // Every point of the polyhedron is between radius - gap and radius from the
   // centre, so at |q| = s its distance differs from |s - radius| by at most gap.
-  const double gap = icosphere_gap(sphere, radius, Eigen::Vector3d::Zero());
+  const double gap = test::icosphere_gap(sphere, radius, Eigen::Vector3d::Zero());
   EXPECT_GT(gap, 1e-3);
   EXPECT_LT(gap, 5e-3);
   const double tolerance = gap + 1e-12;  // plus rounding at this 10 mm scale

@@ -31,18 +31,12 @@ void put_big_endian(std::string& out, T value) {
   out.append(raw.data(), raw.size());
 }
 
-std::string read_bytes(const std::filesystem::path& path) {
-  std::string bytes(static_cast<std::size_t>(std::filesystem::file_size(path)), '\0');
-  std::ifstream in(path, std::ios::binary);
-  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  return bytes;
-}
 
 TEST(PlyTest, BinaryRoundTripIsExact) {
   test::ScratchDir scratch("ply");
   const IndexedMesh torus = make_torus(3.0, 1.0, 24, 12);
   write_ply(torus, scratch / "torus.ply");
-  EXPECT_THAT(read_bytes(scratch / "torus.ply"), HasSubstr("format binary_little_endian 1.0"));
+  EXPECT_THAT(test::read_text(scratch / "torus.ply"), HasSubstr("format binary_little_endian 1.0"));
   const IndexedMesh read = read_ply(scratch / "torus.ply");
   // Doubles stored as doubles: bit-for-bit equal.
   EXPECT_EQ(read.V, torus.V);
@@ -53,7 +47,7 @@ TEST(PlyTest, AsciiRoundTripIsExact) {
   test::ScratchDir scratch("ply");
   const IndexedMesh torus = make_torus(3.0, 1.0, 24, 12);
   write_ply(torus, scratch / "torus.ply", {.ascii = true});
-  EXPECT_THAT(read_bytes(scratch / "torus.ply"), HasSubstr("format ascii 1.0"));
+  EXPECT_THAT(test::read_text(scratch / "torus.ply"), HasSubstr("format ascii 1.0"));
   const IndexedMesh read = read_ply(scratch / "torus.ply");
   // Shortest round-trip text: every double comes back bit for bit.
   EXPECT_EQ(read.V, torus.V);
@@ -143,7 +137,7 @@ TEST(PlyTest, ReadsHandWrittenAsciiWithIntegerCoordinatesAndExtraProperties) {
 TEST(PlyTest, TruncatedBinaryIsReported) {
   test::ScratchDir scratch("ply");
   write_ply(make_box(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()), scratch / "box.ply");
-  const std::string bytes = read_bytes(scratch / "box.ply");
+  const std::string bytes = test::read_text(scratch / "box.ply");
   const auto path = test::write_file(scratch / "cut.ply", bytes.substr(0, bytes.size() - 6));
   EXPECT_THAT([&] { read_ply(path); }, ThrowsMessage<IoError>(HasSubstr("truncated binary PLY")));
   EXPECT_THAT([&] { read_ply(path); },

@@ -22,12 +22,6 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
-std::string read_bytes(const std::filesystem::path& path) {
-  std::string bytes(static_cast<std::size_t>(std::filesystem::file_size(path)), '\0');
-  std::ifstream in(path, std::ios::binary);
-  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  return bytes;
-}
 
 // STL loses the vertex numbering: the welded result numbers vertices in
 // first-occurrence order. Checks that `read` is `original` up to that
@@ -69,7 +63,7 @@ TEST(StlTest, AsciiRoundTripKeepsTopologyAndFloatPrecision) {
   test::ScratchDir scratch("stl");
   const IndexedMesh torus = make_torus(3.0, 1.0, 32, 16);
   write_stl(torus, scratch / "torus.stl", {.ascii = true});
-  EXPECT_EQ(read_bytes(scratch / "torus.stl").substr(0, 5), "solid");
+  EXPECT_EQ(test::read_text(scratch / "torus.stl").substr(0, 5), "solid");
   expect_same_surface(torus, read_stl(scratch / "torus.stl"), kFloatTolerance);
 }
 
@@ -118,7 +112,7 @@ TEST(StlTest, BinaryWhoseHeaderStartsWithSolidIsReadAsBinary) {
   test::ScratchDir scratch("stl");
   const IndexedMesh box = make_box(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones());
   write_stl(box, scratch / "box.stl");
-  std::string bytes = read_bytes(scratch / "box.stl");
+  std::string bytes = test::read_text(scratch / "box.stl");
   bytes.replace(0, 12, "solid header");
   const auto path = test::write_file(scratch / "solid_header.stl", bytes);
   EXPECT_EQ(read_stl(path).num_faces(), 12);
@@ -128,7 +122,7 @@ TEST(StlTest, TruncatedBinaryReportsAnnouncedAndActualSizes) {
   test::ScratchDir scratch("stl");
   const IndexedMesh box = make_box(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones());
   write_stl(box, scratch / "box.stl");
-  const std::string bytes = read_bytes(scratch / "box.stl");
+  const std::string bytes = test::read_text(scratch / "box.stl");
   const auto path = test::write_file(scratch / "cut.stl", bytes.substr(0, 600));
   EXPECT_THAT([&] { read_stl(path); },
               ThrowsMessage<IoError>(
@@ -140,7 +134,7 @@ TEST(StlTest, NanCoordinateNamesTriangleAndVertex) {
   test::ScratchDir scratch("stl");
   const IndexedMesh box = make_box(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones());
   write_stl(box, scratch / "box.stl");
-  std::string bytes = read_bytes(scratch / "box.stl");
+  std::string bytes = test::read_text(scratch / "box.stl");
   // Triangle 3, vertex 1, y coordinate: record start + normal + one corner + x.
   const float nan = std::numeric_limits<float>::quiet_NaN();
   constexpr std::size_t kOffset = 84 + 50 * 3 + 12 + 12 + 4;
@@ -205,7 +199,7 @@ TEST(StlTest, EveryVhfSurfaceLoadsWelded) {
       // Welding shares corners: a closed triangle mesh has about half as many
       // vertices as faces, an unwelded one three times as many.
       EXPECT_LT(mesh.num_vertices(), mesh.num_faces());
-      const std::string bytes = read_bytes(entry.path());
+      const std::string bytes = test::read_text(entry.path());
       if (bytes.compare(0, 5, "solid") == 0 && bytes.find('\0') == std::string::npos) {
         ++ascii_files;
         EXPECT_EQ(static_cast<std::size_t>(mesh.num_faces()), count_ascii_facets(bytes));

@@ -21,12 +21,6 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
-std::string read_bytes(const std::filesystem::path& path) {
-  std::string bytes(static_cast<std::size_t>(std::filesystem::file_size(path)), '\0');
-  std::ifstream in(path, std::ios::binary);
-  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  return bytes;
-}
 
 TEST(VtpTest, RoundTripIsExact) {
   test::ScratchDir scratch("vtp");
@@ -47,7 +41,7 @@ TEST(VtpTest, WritesParaViewHeaderAndScalarArrays) {
   arrays.cell_scalars.emplace_back("face<id>", Eigen::VectorXd::LinSpaced(12, 0, 11));
   write_vtp(box, scratch / "box.vtp", arrays);
 
-  const std::string text = read_bytes(scratch / "box.vtp");
+  const std::string text = test::read_text(scratch / "box.vtp");
   EXPECT_THAT(text, HasSubstr("<VTKFile type=\"PolyData\" version=\"1.0\" "
                               "byte_order=\"LittleEndian\" header_type=\"UInt64\">"));
   tinyxml2::XMLDocument document;
