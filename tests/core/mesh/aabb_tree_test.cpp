@@ -55,7 +55,6 @@ double brute_force_squared_distance(const IndexedMesh& mesh, const Eigen::Vector
   return best;
 }
 
-
 Eigen::Vector3d uniform_in(const Eigen::AlignedBox3d& box, std::mt19937& rng) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const Eigen::Vector3d s(unit(rng), unit(rng), unit(rng));

@@ -12,7 +12,6 @@
 namespace mmm::mesh {
 namespace {
 
-
 TEST(PenetrationTest, OverlappingSpheresPenetrateByHalfTheirRadius) {
   const double radius = 10.0;
   const Eigen::Vector3d center_b(15, 0, 0);

@@ -14,7 +14,6 @@
 namespace mmm::mesh {
 namespace {
 
-
 Eigen::Vector3d random_direction(std::mt19937& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
   return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();

@@ -31,7 +31,6 @@ void put_big_endian(std::string& out, T value) {
   out.append(raw.data(), raw.size());
 }
 
-
 TEST(PlyTest, BinaryRoundTripIsExact) {
   test::ScratchDir scratch("ply");
   const IndexedMesh torus = make_torus(3.0, 1.0, 24, 12);

@@ -22,7 +22,6 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
-
 // STL loses the vertex numbering: the welded result numbers vertices in
 // first-occurrence order. Checks that `read` is `original` up to that
 // renumbering: same faces in the same order, a one-to-one vertex map, and

@@ -21,7 +21,6 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
-
 TEST(VtpTest, RoundTripIsExact) {
   test::ScratchDir scratch("vtp");
   const IndexedMesh torus = make_torus(3.0, 1.0, 24, 12);
