@@ -1,0 +1,57 @@
+#include "workflow/node_registry.h"
+
+#include <algorithm>
+
+#include "core/errors.h"
+
+namespace mmm::workflow {
+namespace {
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+void NodeRegistry::add(NodeSpec spec, RunFunction run) {
+  if (types_.count(spec.name()) > 0) {
+    throw InvalidInputError("node type '" + spec.name() + "' is registered twice");
+  }
+  std::string name = spec.name();
+  types_.emplace(std::move(name), NodeType{std::move(spec), std::move(run)});
+}
+
+const NodeType* NodeRegistry::find(std::string_view name) const {
+  const auto it = types_.find(name);
+  return it == types_.end() ? nullptr : &it->second;
+}
+
+std::vector<const NodeType*> NodeRegistry::all() const {
+  std::vector<const NodeType*> out;
+  out.reserve(types_.size());
+  for (const auto& [name, type] : types_) out.push_back(&type);
+  return out;
+}
+
+std::vector<std::string> NodeRegistry::similar_names(std::string_view name) const {
+  std::vector<std::string> out;
+  for (const auto& [candidate, type] : types_) {
+    const bool prefix = candidate.size() >= 3 && name.size() >= 3 &&
+                        candidate.compare(0, 3, name.substr(0, 3)) == 0;
+    if (edit_distance(candidate, name) <= 2 || prefix) out.push_back(candidate);
+  }
+  return out;
+}
+
+}  // namespace mmm::workflow
