@@ -10,6 +10,7 @@
 
 #include "app/commands/commands.h"
 #include "core/errors.h"
+#include "nodes/registry.h"
 
 namespace {
 
@@ -20,6 +21,8 @@ int run(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("mmm ") + MMM_VERSION);
   mmm::app::register_mesh_commands(app);
+  const mmm::workflow::NodeRegistry registry = mmm::nodes::make_node_registry();
+  mmm::app::register_workflow_commands(app, registry);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,8 +1,9 @@
 #include "workflow/node_spec.h"
 
 #include <algorithm>
+#include <array>
+#include <charconv>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 #include "core/errors.h"
@@ -24,11 +25,16 @@ const T* find_named(const std::vector<T>& items, std::string_view name) {
   return it == items.end() ? nullptr : &*it;
 }
 
+// Shortest text that reads back to the same double (1e-06, not
+// 9.99...e-07), in plain decimal notation for everyday magnitudes.
 std::string number_text(double value) {
-  std::ostringstream out;
-  out.precision(17);
-  out << value;
-  return out.str();
+  std::array<char, 400> buffer{};
+  const double magnitude = std::abs(value);
+  const bool everyday = magnitude == 0 || (magnitude >= 1e-4 && magnitude < 1e15);
+  const auto result = everyday ? std::to_chars(buffer.data(), buffer.data() + buffer.size(), value,
+                                               std::chars_format::fixed)
+                               : std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+  return {buffer.data(), result.ptr};
 }
 
 }  // namespace

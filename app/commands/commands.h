@@ -6,10 +6,15 @@
 
 #include <CLI/CLI.hpp>
 
+#include "workflow/node_registry.h"
+
 namespace mmm::app {
 
 // mmm mesh info|convert|decimate|survey
 void register_mesh_commands(CLI::App& app);
+
+// mmm validate|graph|nodes (the registry must outlive the parse)
+void register_workflow_commands(CLI::App& app, const workflow::NodeRegistry& registry);
 
 // Exit code requested by the command that ran (0 unless it called
 // set_exit_code).

@@ -1,0 +1,151 @@
+// End-to-end checks of `mmm validate`, `mmm graph` and `mmm nodes`: run the
+// real executable (with the node types of nodes/) the way a user would.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "tests/support/test_data.h"
+
+namespace mmm::app {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+// Runs `[environment] mmm arguments`, stdout and stderr apart.
+CommandResult run_mmm(const std::string& arguments, const std::string& environment = {}) {
+  const mmm::test::ScratchDir dir("wf-cli");
+  const auto err_file = dir / "stderr.txt";
+  const std::string command = environment + " " + mmm::test::mmm_executable().string() + " " +
+                              arguments + " 2>" + err_file.string();
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return {};
+  CommandResult result;
+  std::array<char, 4096> buffer{};
+  size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    result.out.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.err = mmm::test::read_text(err_file);
+  return result;
+}
+
+std::string example() {
+  return (mmm::test::source_dir() / "schemas/examples/mesh_demo.yaml").string();
+}
+
+std::string malformed(const std::string& name) {
+  return (mmm::test::source_dir() / "tests/workflow/definition/malformed" / name).string();
+}
+
+TEST(WorkflowCliTest, ValidateAcceptsTheExample) {
+  const CommandResult result = run_mmm("validate " + example());
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(result.out, example() + ": valid (3 nodes)\n");
+  EXPECT_EQ(result.err, "");
+}
+
+TEST(WorkflowCliTest, ValidatePrintsEveryLocatedProblemAndExitsOne) {
+  const std::string file = malformed("many_problems.yaml");
+  const CommandResult result = run_mmm("validate " + file);
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_EQ(result.out, "");
+  EXPECT_THAT(result.err, HasSubstr(file + ":10:22: parameter 'format' of node 'load': expects "
+                                           "one of {stl, obj, ply, off, vtp}, got 'stp'\n"));
+  EXPECT_THAT(result.err,
+              HasSubstr(file + ":17:20: input 'mesh' of node 'measure' refers to unknown node "
+                               "'simplyfy'; did you mean 'simplify'?"));
+  EXPECT_THAT(result.err, HasSubstr(file + ":23:5: nodes[4]: unknown key 'extra'"));
+  EXPECT_THAT(result.err, HasSubstr(file + ": 10 problem(s)\n"));
+}
+
+TEST(WorkflowCliTest, ValidateUsesTheRealNodeTypes) {
+  // The fixture's takes_integer node exists only in the test registry of
+  // tests/workflow: the executable does not know it.
+  const std::string file = malformed("study_default_wrong_type.yaml");
+  const CommandResult result = run_mmm("validate " + file);
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.err, HasSubstr(file + ":7:14: default of study input 'target' must be "
+                                           "Integer, got number 2000.5\n"));
+  EXPECT_THAT(result.err,
+              HasSubstr(file + ":13:11: node 'wants_target': unknown node type 'takes_integer'"));
+}
+
+TEST(WorkflowCliTest, ValidateMissingFileExitsOne) {
+  const CommandResult result = run_mmm("validate /nonexistent/wf.yaml");
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.err, HasSubstr("/nonexistent/wf.yaml: no such file\n"));
+}
+
+TEST(WorkflowCliTest, GraphPrintsDotForAValidWorkflow) {
+  const CommandResult result = run_mmm("graph " + example());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_THAT(result.out, ::testing::StartsWith("digraph \"mesh_demo\" {\n"));
+  EXPECT_THAT(result.out, HasSubstr("\"load\" -> \"simplify\" [label=\"mesh -> mesh\\nMesh\"];"));
+  EXPECT_THAT(result.out, HasSubstr("\"study.surface\" [shape=ellipse"));
+  EXPECT_THAT(result.out, ::testing::EndsWith("}\n"));
+}
+
+TEST(WorkflowCliTest, GraphOfAnInvalidWorkflowPrintsDiagnosticsOnly) {
+  const std::string file = malformed("cycle.yaml");
+  const CommandResult result = run_mmm("graph " + file);
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_EQ(result.out, "");  // nothing for dot to misread
+  EXPECT_THAT(result.err, HasSubstr(file + ":9:9: cycle: coarse -> coarsest -> coarser -> coarse"));
+}
+
+TEST(WorkflowCliTest, NodesListsTypesPortsAndParameters) {
+  const CommandResult result = run_mmm("nodes");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_THAT(result.out, HasSubstr("decimate_mesh (version 1)\n"));
+  EXPECT_THAT(result.out, HasSubstr("load_mesh (version 1)\n"));
+  EXPECT_THAT(result.out, HasSubstr("measure_mesh (version 1)\n"));
+  EXPECT_THAT(result.out, HasSubstr("(default 60 deg, range [1, 180])"));
+  EXPECT_THAT(result.out, HasSubstr("one of {stl, obj, ply, off, vtp}"));
+  EXPECT_THAT(result.out,
+              ::testing::EndsWith("workflow file format: schemas/workflow.schema.yaml (examples in "
+                                  "schemas/examples/)\n"));
+}
+
+TEST(WorkflowCliTest, NodesJsonIsMachineReadable) {
+  const CommandResult result = run_mmm("nodes --json");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto json = nlohmann::json::parse(result.out);
+  ASSERT_EQ(json["node_types"].size(), 3U);
+  const auto& decimate = json["node_types"][0];
+  EXPECT_EQ(decimate["name"], "decimate_mesh");
+  EXPECT_EQ(decimate["inputs"][0]["type"], "Mesh");
+  EXPECT_EQ(decimate["params"][0]["name"], "target_faces");
+  EXPECT_EQ(decimate["params"][0]["default"], 5000);
+  EXPECT_EQ(decimate["params"][0]["min"], 4);
+  EXPECT_EQ(json["schema"], "schemas/workflow.schema.yaml");
+}
+
+TEST(WorkflowCliTest, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(run_mmm("validate").exit_code, 2);
+  EXPECT_EQ(run_mmm("graph").exit_code, 2);
+  EXPECT_EQ(run_mmm("nodes --yaml").exit_code, 2);
+}
+
+TEST(WorkflowCliTest, MissingSchemaIsAnErrorNamingMmmSchemaDir) {
+  const CommandResult result = run_mmm("validate " + example(), "MMM_SCHEMA_DIR=/nonexistent");
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.err, HasSubstr("MMM_SCHEMA_DIR"));
+  EXPECT_THAT(result.out, Not(HasSubstr("valid")));
+}
+
+}  // namespace
+}  // namespace mmm::app
