@@ -5,6 +5,7 @@
 #include "core/mesh/io/ply.h"
 #include "core/mesh/mass_properties.h"
 #include "core/mesh/mesh_check.h"
+#include "nodes/mesh_check_json.h"
 
 namespace mmm::nodes {
 namespace {
@@ -36,24 +37,7 @@ void MeasureMesh::run(workflow::NodeContext& context) {
 
   nlohmann::json report;
   report["units"] = "mm";
-  report["check"] = {{"vertices", c.vertices},
-                     {"faces", c.faces},
-                     {"edges", c.edges},
-                     {"boundary_edges", c.boundary_edges},
-                     {"boundary_loops", c.boundary_loops},
-                     {"non_manifold_edges", c.non_manifold_edges},
-                     {"non_manifold_vertices", c.non_manifold_vertices},
-                     {"inconsistently_oriented_edges", c.inconsistently_oriented_edges},
-                     {"degenerate_faces", c.degenerate_faces},
-                     {"duplicate_vertices", c.duplicate_vertices},
-                     {"unreferenced_vertices", c.unreferenced_vertices},
-                     {"connected_components", c.connected_components},
-                     {"euler_characteristic", c.euler_characteristic},
-                     {"closed", c.closed()},
-                     {"manifold", c.manifold()},
-                     {"orientation_consistent", c.orientation_consistent()},
-                     {"watertight", c.watertight()},
-                     {"problems", c.problems()}};
+  report["check"] = mesh_check_json(c);
   report["mass_properties"] = {
       {"area", p.area},
       {"volume", has_volume ? nlohmann::json(p.volume) : nlohmann::json()},

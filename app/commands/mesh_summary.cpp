@@ -3,6 +3,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "nodes/mesh_check_json.h"
+
 namespace mmm::app {
 namespace {
 
@@ -43,20 +45,7 @@ nlohmann::json to_json(const MeshSummary& s, const std::string& units) {
   out["faces"] = c.faces;
   out["closed"] = c.closed();
   out["watertight"] = c.watertight();
-  out["check"] = {{"edges", c.edges},
-                  {"boundary_edges", c.boundary_edges},
-                  {"boundary_loops", c.boundary_loops},
-                  {"non_manifold_edges", c.non_manifold_edges},
-                  {"non_manifold_vertices", c.non_manifold_vertices},
-                  {"inconsistently_oriented_edges", c.inconsistently_oriented_edges},
-                  {"degenerate_faces", c.degenerate_faces},
-                  {"duplicate_vertices", c.duplicate_vertices},
-                  {"unreferenced_vertices", c.unreferenced_vertices},
-                  {"connected_components", c.connected_components},
-                  {"euler_characteristic", c.euler_characteristic},
-                  {"manifold", c.manifold()},
-                  {"orientation_consistent", c.orientation_consistent()},
-                  {"problems", c.problems()}};
+  out["check"] = nodes::mesh_check_json(c);
   // Volume is null when it is not a property of the shape (open surface).
   out["volume"] = s.has_volume() ? nlohmann::json(s.properties.volume) : nlohmann::json();
   out["outward_oriented"] = s.outward();

@@ -3,10 +3,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -19,30 +16,17 @@ namespace {
 
 using ::testing::HasSubstr;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
+using test::CommandResult;
+using test::run_mmm;
 
-CommandResult run_mmm(const std::string& arguments) {
-  const std::string command = test::mmm_executable().string() + " " + arguments + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return {};
-  CommandResult result;
-  std::array<char, 4096> buffer{};
-  size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    result.output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+// Everything the command printed, for message checks.
+std::string printed(const CommandResult& result) { return result.out + result.err; }
 
 TEST(MeshCliTest, InfoJsonOnGluteusMediusReportsAClosedMeshAndItsVolume) {
   const auto file = test::data_dir() / "vhf/Right/VHF_Right_Muscle_GluteusMedius_smooth.stl";
   const CommandResult result = run_mmm("mesh info " + file.string() + " --json");
-  ASSERT_EQ(result.exit_code, 0) << result.output;
-  const auto json = nlohmann::json::parse(result.output);
+  ASSERT_EQ(result.exit_code, 0) << printed(result);
+  const auto json = nlohmann::json::parse(result.out);
   EXPECT_TRUE(json["closed"].get<bool>());
   EXPECT_TRUE(json["watertight"].get<bool>());
   EXPECT_TRUE(json["outward_oriented"].get<bool>());
@@ -58,15 +42,15 @@ TEST(MeshCliTest, InfoTextOnPrimitiveShowsExactVolume) {
   mesh::write_mesh(mesh::make_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(10, 20, 30)),
                    dir / "box.ply");
   const CommandResult result = run_mmm("mesh info " + (dir / "box.ply").string());
-  ASSERT_EQ(result.exit_code, 0) << result.output;
-  EXPECT_THAT(result.output, HasSubstr("volume      6000.0 mm^3"));
-  EXPECT_THAT(result.output, HasSubstr("closed      yes"));
+  ASSERT_EQ(result.exit_code, 0) << printed(result);
+  EXPECT_THAT(printed(result), HasSubstr("volume      6000.0 mm^3"));
+  EXPECT_THAT(printed(result), HasSubstr("closed      yes"));
 }
 
 TEST(MeshCliTest, MissingFileFailsWithItsPath) {
   const CommandResult result = run_mmm("mesh info /nonexistent/muscle.stl");
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_THAT(result.output, HasSubstr("/nonexistent/muscle.stl"));
+  EXPECT_THAT(printed(result), HasSubstr("/nonexistent/muscle.stl"));
 }
 
 TEST(MeshCliTest, UsageErrorsExitWithTwo) {
@@ -81,7 +65,7 @@ TEST(MeshCliTest, ConvertWritesAReadableFileInMillimetres) {
   const auto out = dir / "femur_mm.stl";
   const CommandResult result =
       run_mmm("mesh convert " + femur.string() + " " + out.string() + " --scale 1000");
-  ASSERT_EQ(result.exit_code, 0) << result.output;
+  ASSERT_EQ(result.exit_code, 0) << printed(result);
   const mesh::IndexedMesh converted = mesh::read_mesh(out);
   EXPECT_EQ(converted.num_faces(), 908);
   // A femur is 350-500 mm long; in metres it would be below 1.
@@ -96,7 +80,7 @@ TEST(MeshCliTest, SurveyOfGait2392WritesReportAndVtpCopies) {
   const auto geometry = test::data_dir() / "gait2392/Geometry";
   const CommandResult result =
       run_mmm("mesh survey " + geometry.string() + " --scale 1000 --out " + dir.path().string());
-  ASSERT_EQ(result.exit_code, 0) << result.output;
+  ASSERT_EQ(result.exit_code, 0) << printed(result);
   const auto json = nlohmann::json::parse(test::read_text(dir / "survey.json"));
   ASSERT_EQ(json.size(), 10U);  // the ten .vtp files of the model
   for (const auto& entry : json) {

@@ -3,10 +3,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -18,30 +15,8 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string out;  // stdout
-  std::string err;  // stderr
-};
-
-// Runs `[environment] mmm arguments`, stdout and stderr apart.
-CommandResult run_mmm(const std::string& arguments, const std::string& environment = {}) {
-  const mmm::test::ScratchDir dir("wf-cli");
-  const auto err_file = dir / "stderr.txt";
-  const std::string command = environment + " " + mmm::test::mmm_executable().string() + " " +
-                              arguments + " 2>" + err_file.string();
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return {};
-  CommandResult result;
-  std::array<char, 4096> buffer{};
-  size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    result.out.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  result.err = mmm::test::read_text(err_file);
-  return result;
-}
+using test::CommandResult;
+using test::run_mmm;
 
 std::string example() {
   return (mmm::test::source_dir() / "schemas/examples/mesh_demo.yaml").string();

@@ -1,5 +1,9 @@
 #include "tests/support/test_data.h"
 
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <random>
@@ -38,6 +42,25 @@ ScratchDir::ScratchDir(const std::string& label) {
 ScratchDir::~ScratchDir() {
   std::error_code ignored;
   std::filesystem::remove_all(path_, ignored);
+}
+
+CommandResult run_mmm(const std::string& arguments, const std::string& environment) {
+  const ScratchDir dir("cli");
+  const auto err_file = dir / "stderr.txt";
+  const std::string command =
+      environment + " " + mmm_executable().string() + " " + arguments + " 2>" + err_file.string();
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return {};
+  CommandResult result;
+  std::array<char, 4096> buffer{};
+  size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) {
+    result.out.append(buffer.data(), n);
+  }
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.err = read_text(err_file);
+  return result;
 }
 
 std::string read_text(const std::filesystem::path& path) {

@@ -18,6 +18,17 @@ std::filesystem::path binary_dir();
 // Path to build/bin/mmm, for tests that run the command line.
 std::filesystem::path mmm_executable();
 
+// Result of running the mmm executable.
+struct CommandResult {
+  int exit_code = -1;  // -1 when it did not exit normally
+  std::string out;     // stdout
+  std::string err;     // stderr
+};
+
+// Runs `[environment] build/bin/mmm arguments` through the shell (arguments
+// are not quoted for you), capturing stdout and stderr apart.
+CommandResult run_mmm(const std::string& arguments, const std::string& environment = {});
+
 // A fresh empty folder under the system temp dir, removed when destroyed.
 class ScratchDir {
  public:

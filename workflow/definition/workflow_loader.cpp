@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "core/errors.h"
-#include "workflow/definition/suggest.h"
+#include "workflow/suggest.h"
 #include "workflow/definition/workflow_validation.h"
 #include "workflow/definition/yaml_scalar.h"
 #include "workflow/definition/yaml_schema.h"

@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "workflow/definition/suggest.h"
+#include "workflow/suggest.h"
 #include "workflow/definition/workflow_graph.h"
 
 namespace mmm::workflow {

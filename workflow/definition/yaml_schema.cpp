@@ -17,7 +17,7 @@
 #include <utility>
 
 #include "core/errors.h"
-#include "workflow/definition/suggest.h"
+#include "workflow/suggest.h"
 #include "workflow/definition/yaml_scalar.h"
 
 namespace mmm::workflow {

@@ -1,4 +1,4 @@
-#include "workflow/definition/suggest.h"
+#include "workflow/suggest.h"
 
 #include <algorithm>
 #include <utility>
