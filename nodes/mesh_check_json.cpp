@@ -2,7 +2,8 @@
 
 namespace mmm::nodes {
 
-nlohmann::json mesh_check_json(const mesh::MeshCheckReport& c) {
+nlohmann::json mesh_check_json(const mesh::MeshCheckReport& report) {
+  const mesh::MeshCheckReport& c = report;
   return {{"vertices", c.vertices},
           {"faces", c.faces},
           {"edges", c.edges},

@@ -102,7 +102,7 @@ std::vector<std::string> describe_key_changes(const CacheKeyParts& before,
     }
   }
   for (const auto& [name, value] : before.params) {
-    if (now.params.count(name) == 0) changes.push_back("parameter '" + name + "' was removed");
+    if (!now.params.contains(name)) changes.push_back("parameter '" + name + "' was removed");
   }
   for (const auto& [port, hash] : now.input_hashes) {
     const auto it = before.input_hashes.find(port);
@@ -114,7 +114,7 @@ std::vector<std::string> describe_key_changes(const CacheKeyParts& before,
     }
   }
   for (const auto& [port, hash] : before.input_hashes) {
-    if (now.input_hashes.count(port) == 0) {
+    if (!now.input_hashes.contains(port)) {
       changes.push_back("input '" + port + "' is no longer connected");
     }
   }

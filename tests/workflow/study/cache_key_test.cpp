@@ -18,7 +18,7 @@ NodeSpec spec() {
       .output<port::Mesh>("decimated", "Result");
 }
 
-CacheKeyParts parts(std::map<std::string, ParamValue> given, std::string input_hash) {
+CacheKeyParts parts(const std::map<std::string, ParamValue>& given, std::string input_hash) {
   return {"decimate_mesh", 1, effective_params(spec(), given), {{"mesh", std::move(input_hash)}}};
 }
 
