@@ -80,7 +80,7 @@ const PortSpec& NodeContext::output_port(std::string_view port) {
     throw InvalidInputError("node type " + spec_->name() + ": no output '" + std::string(port) +
                             "'");
   }
-  if (outputs_.count(spec->name) > 0) {
+  if (outputs_.contains(spec->name)) {
     throw InvalidInputError("node type " + spec_->name() + ": output '" + spec->name +
                             "' set twice");
   }

@@ -8,7 +8,7 @@
 namespace mmm::workflow {
 
 void NodeRegistry::add(NodeSpec spec, RunFunction run) {
-  if (types_.count(spec.name()) > 0) {
+  if (types_.contains(spec.name())) {
     throw InvalidInputError("node type '" + spec.name() + "' is registered twice");
   }
   std::string name = spec.name();
