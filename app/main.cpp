@@ -1,7 +1,8 @@
 // mmm: patient-specific moving musculoskeletal models of the lower limb.
 // Entry point: parses the subcommand and maps errors to exit codes
 //   0 success, 1 the command failed (message names file/field and a hint),
-//   2 the command line itself is wrong.
+//   2 the command line itself is wrong, 3 the study waits for a manual task,
+//   4 another runner holds the study (see app/commands/commands.h).
 
 #include <CLI/CLI.hpp>
 #include <exception>
@@ -23,6 +24,7 @@ int run(int argc, char** argv) {
   mmm::app::register_mesh_commands(app);
   const mmm::workflow::NodeRegistry registry = mmm::nodes::make_node_registry();
   mmm::app::register_workflow_commands(app, registry);
+  mmm::app::register_study_commands(app, registry);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -21,7 +21,9 @@ workflow::NodeSpec DecimateMesh::spec() {
 }
 
 void DecimateMesh::run(workflow::NodeContext& context) {
+  context.progress(0, 3, "reading");
   const mesh::IndexedMesh input = mesh::read_ply(context.input("mesh").path);
+  context.progress(1, 3, "decimating");
   mesh::DecimateReport report;
   const mesh::IndexedMesh coarse =
       mesh::decimate(input,
@@ -30,9 +32,11 @@ void DecimateMesh::run(workflow::NodeContext& context) {
                      &report);
   context.info("decimated " + std::to_string(report.faces_before) + " -> " +
                std::to_string(report.faces_after) + " faces");
+  context.progress(2, 3, "writing");
   const std::filesystem::path out = context.scratch_dir() / "decimated.ply";
   mesh::write_ply(coarse, out);
   context.set_output_file("decimated", out);
+  context.progress(3, 3, "done");
 }
 
 }  // namespace mmm::nodes

@@ -52,4 +52,9 @@ std::string port_type_names() {
   return names;
 }
 
+bool is_value_type(PortType type) {
+  return type == PortType::kNumber || type == PortType::kInteger || type == PortType::kString ||
+         type == PortType::kBool;
+}
+
 }  // namespace mmm::workflow

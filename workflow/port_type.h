@@ -48,6 +48,11 @@ inline std::string_view port_type_name(PortType type) { return port_type_info(ty
 // std::nullopt for an unknown name.
 std::optional<PortType> port_type_from_name(std::string_view name);
 
+// Whether the type holds a single value (Number, Integer, String, Bool: a
+// study input may give it a default, a command line may type it) rather than
+// the content of a file.
+bool is_value_type(PortType type);
+
 // Comma-separated list of every type name, for error hints.
 std::string port_type_names();
 

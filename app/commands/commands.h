@@ -16,6 +16,16 @@ void register_mesh_commands(CLI::App& app);
 // mmm validate|graph|nodes (the registry must outlive the parse)
 void register_workflow_commands(CLI::App& app, const workflow::NodeRegistry& registry);
 
+// mmm study create|set, mmm run, mmm status, mmm explain
+void register_study_commands(CLI::App& app, const workflow::NodeRegistry& registry);
+
+// Exit codes of every command (documented in the README).
+inline constexpr int kExitOk = 0;       // done
+inline constexpr int kExitFailed = 1;   // the command (or a node) failed; message says why
+inline constexpr int kExitUsage = 2;    // the command line is wrong
+inline constexpr int kExitWaiting = 3;  // the study waits for a manual task
+inline constexpr int kExitLocked = 4;   // another runner holds the study
+
 // Exit code requested by the command that ran (0 unless it called
 // set_exit_code).
 int exit_code();

@@ -253,11 +253,6 @@ class Checker {
 
 }  // namespace
 
-bool is_value_type(PortType type) {
-  return type == PortType::kNumber || type == PortType::kInteger || type == PortType::kString ||
-         type == PortType::kBool;
-}
-
 std::vector<Diagnostic> validate_workflow(const WorkflowDefinition& definition,
                                           const NodeRegistry& registry) {
   return Checker(definition, registry).run();

@@ -22,8 +22,4 @@ namespace mmm::workflow {
 std::vector<Diagnostic> validate_workflow(const WorkflowDefinition& definition,
                                           const NodeRegistry& registry);
 
-// True for the port types a study input may give a default to: Number,
-// Integer, String, Bool.
-bool is_value_type(PortType type);
-
 }  // namespace mmm::workflow

@@ -14,6 +14,7 @@
 
 #include "core/errors.h"
 #include "core/hash/sha256.h"
+#include "workflow/fault_injection.h"
 
 namespace mmm::workflow {
 namespace {
@@ -143,9 +144,11 @@ class TempBlob {
     if (::fchmod(fd_.get(), kBlobMode) != 0) {
       throw IoError(path_, "cannot set permissions: " + errno_text(errno));
     }
+    fault_point("artifact.before_sync");
     if (::fsync(fd_.get()) != 0) {
       throw IoError(path_, "cannot sync artifact data to disk: " + errno_text(errno));
     }
+    fault_point("artifact.before_rename");
     const std::filesystem::path shard = final_path.parent_path();
     if (::mkdir(shard.c_str(), 0755) == 0) {
       fsync_directory(root);
@@ -157,6 +160,7 @@ class TempBlob {
                                     ": " + errno_text(errno));
     }
     committed_ = true;
+    fault_point("artifact.after_rename");
     fsync_directory(shard);
   }
 
@@ -223,7 +227,13 @@ std::string ArtifactStore::put(std::string_view bytes) {
   const std::filesystem::path final_path = path_of(hash);
   if (is_regular_file_of_size(final_path, bytes.size())) return hash;
   TempBlob temp(root_);
-  temp.write(bytes);
+  // Fault points: a crash half-way through the bytes must leave only a
+  // temporary file behind.
+  fault_point("artifact.before_write");
+  const std::size_t half = bytes.size() / 2;
+  temp.write(bytes.substr(0, half));
+  fault_point("artifact.mid_write");
+  temp.write(bytes.substr(half));
   temp.commit(root_, final_path);
   return hash;
 }
@@ -238,12 +248,14 @@ std::string ArtifactStore::put_file(const std::filesystem::path& source) {
   hash::Sha256 hasher;
   std::vector<char> chunk(kCopyChunk);
   std::size_t size = 0;
+  fault_point("artifact.before_write");
   while (true) {
     const std::size_t got = read_some(in.get(), chunk, source);
     if (got == 0) break;
     const std::string_view piece(chunk.data(), got);
     hasher.update(piece);
     temp.write(piece);
+    if (size == 0) fault_point("artifact.mid_write");
     size += got;
   }
   std::string hash = hash::to_hex(hasher.finish());

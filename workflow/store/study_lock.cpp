@@ -7,10 +7,11 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
-#include <ctime>
 #include <sstream>
 #include <system_error>
 #include <thread>
+
+#include "workflow/host_and_time.h"
 
 namespace mmm::workflow {
 namespace {
@@ -20,21 +21,6 @@ constexpr std::chrono::milliseconds kRetryInterval{50};
 
 std::string errno_text(int code) {
   return std::error_code(code, std::generic_category()).message();
-}
-
-std::string host_name() {
-  std::array<char, 256> name{};
-  if (::gethostname(name.data(), name.size() - 1) != 0) return "unknown";
-  return name.data();
-}
-
-std::string utc_now() {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm utc{};
-  ::gmtime_r(&now, &utc);
-  std::array<char, 32> text{};
-  const std::size_t size = std::strftime(text.data(), text.size(), "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return {text.data(), size};
 }
 
 // Replaces the content of the locked file by the holder record. Informational

@@ -1,0 +1,114 @@
+#include "workflow/run/export_outputs.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <system_error>
+
+#include "core/errors.h"
+#include "workflow/fault_injection.h"
+#include "workflow/host_and_time.h"
+
+namespace mmm::workflow {
+namespace {
+
+struct RecordedExport {
+  std::string hash;
+  std::string file;
+};
+
+std::map<std::string, RecordedExport> recorded_exports(Database& database) {
+  std::map<std::string, RecordedExport> exports;
+  Statement select = database.prepare("SELECT name, hash, file FROM exports");
+  while (select.step()) {
+    exports[select.column_text(0)] = {select.column_text(1), select.column_text(2)};
+  }
+  return exports;
+}
+
+void sync_path(const std::filesystem::path& path, int flags) {
+  const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+// Copies the blob to `target` through a temporary file in the same folder.
+void copy_atomically(const std::filesystem::path& blob, const std::filesystem::path& target) {
+  const std::filesystem::path temporary =
+      target.parent_path() / ("." + target.filename().string() + ".tmp");
+  std::error_code error;
+  std::filesystem::remove(temporary, error);  // left by a crashed export
+  std::filesystem::copy_file(blob, temporary, error);
+  if (error) throw IoError(temporary, "cannot write the exported output: " + error.message());
+  std::filesystem::permissions(temporary, std::filesystem::perms::owner_write,
+                               std::filesystem::perm_options::add, error);
+  sync_path(temporary, O_RDONLY);
+  fault_point("export.before_rename");
+  std::filesystem::rename(temporary, target, error);
+  if (error)
+    throw IoError(target, "cannot move the exported output into place: " + error.message());
+  sync_path(target.parent_path(), O_RDONLY | O_DIRECTORY);
+}
+
+}  // namespace
+
+std::string export_file_name(const std::string& name, PortType type) {
+  return name + std::string(port_type_info(type).extension);
+}
+
+ExportReport export_outputs(
+    Study& study, const std::map<std::string, std::map<std::string, OutputArtifact>>& available) {
+  ExportReport report;
+  const std::filesystem::path folder = study.outputs_dir();
+  std::filesystem::create_directories(folder);
+  std::map<std::string, RecordedExport> recorded = recorded_exports(study.database());
+  for (const WorkflowOutput& output : study.workflow().outputs) {
+    const auto node = available.find(output.source.node);
+    const OutputArtifact* artifact = nullptr;
+    if (node != available.end()) {
+      const auto port = node->second.find(output.source.port);
+      if (port != node->second.end()) artifact = &port->second;
+    }
+    const auto previous = recorded.find(output.name);
+    std::error_code error;
+    if (artifact == nullptr) {
+      if (previous == recorded.end()) continue;
+      std::filesystem::remove(folder / previous->second.file, error);
+      Transaction transaction(study.database());
+      study.database()
+          .prepare("DELETE FROM exports WHERE name = ?")
+          .bind_text(1, output.name)
+          .step();
+      transaction.commit();
+      report.removed.push_back(output.name);
+      continue;
+    }
+    const std::string file = export_file_name(output.name, artifact->type);
+    const std::filesystem::path target = folder / file;
+    const std::filesystem::path blob = study.artifacts().path_of(artifact->hash);
+    if (previous != recorded.end() && previous->second.hash == artifact->hash &&
+        previous->second.file == file && std::filesystem::is_regular_file(target, error) &&
+        std::filesystem::file_size(target, error) == std::filesystem::file_size(blob, error)) {
+      continue;  // already current
+    }
+    if (previous != recorded.end() && previous->second.file != file) {
+      std::filesystem::remove(folder / previous->second.file, error);
+    }
+    copy_atomically(blob, target);
+    Transaction transaction(study.database());
+    study.database()
+        .prepare(
+            "INSERT OR REPLACE INTO exports(name, hash, file, exported_at) VALUES (?, ?, ?, ?)")
+        .bind_text(1, output.name)
+        .bind_text(2, artifact->hash)
+        .bind_text(3, file)
+        .bind_text(4, utc_now())
+        .step();
+    transaction.commit();
+    report.written.push_back(output.name);
+  }
+  return report;
+}
+
+}  // namespace mmm::workflow

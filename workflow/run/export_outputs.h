@@ -1,0 +1,32 @@
+#pragma once
+// The workflow's exported outputs, copied from the artifact store into
+// DIR/outputs/<name><extension> for people and other tools (ParaView opens
+// the .ply, a spreadsheet the .json/.csv). Each file is written to a
+// temporary name, flushed and renamed, so outputs/ never holds a partial
+// file; a file whose content is already current is left alone. An output
+// whose node has no current result (failed, waiting, blocked) has its old
+// file removed, so outputs/ never shows a result that does not match the
+// study's current inputs and parameters.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "workflow/study/execution_records.h"
+#include "workflow/study/study.h"
+
+namespace mmm::workflow {
+
+struct ExportReport {
+  std::vector<std::string> written;  // export names whose file was (re)written
+  std::vector<std::string> removed;  // export names whose stale file was removed
+};
+
+// `available`: node -> port -> artifact, the current results.
+ExportReport export_outputs(
+    Study& study, const std::map<std::string, std::map<std::string, OutputArtifact>>& available);
+
+// The file name of an export: name + the extension of its port type.
+std::string export_file_name(const std::string& name, PortType type);
+
+}  // namespace mmm::workflow
