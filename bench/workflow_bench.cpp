@@ -63,7 +63,7 @@ std::filesystem::path bench_root() {
 }
 
 std::filesystem::path workflow_file() {
-  const std::filesystem::path file = bench_root() / "noop1000.yaml";
+  std::filesystem::path file = bench_root() / "noop1000.yaml";
   if (std::filesystem::exists(file)) return file;
   std::ofstream out(file);
   out << "mmm_workflow: 1\nname: noop1000\nnodes:\n";
@@ -107,8 +107,8 @@ void first_run(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * kNodes);
 }
-BENCHMARK(first_run)->Name("first_run_j1")->Arg(1)->Iterations(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(first_run)->Name("first_run_j2")->Arg(2)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(first_run)->Name("first_run_j1")->Arg(1)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(first_run)->Name("first_run_j2")->Arg(2)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 const std::filesystem::path& finished_study() {
   static const std::filesystem::path kDir = [] {
@@ -125,7 +125,7 @@ void no_change_rerun(benchmark::State& state) {
   for (auto _ : state) run_once(dir, 1);
   state.SetItemsProcessed(state.iterations() * kNodes);
 }
-BENCHMARK(no_change_rerun)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(no_change_rerun)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void plan(benchmark::State& state) {
   const std::filesystem::path& dir = finished_study();
@@ -136,7 +136,7 @@ void plan(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * kNodes);
 }
-BENCHMARK(plan)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(plan)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

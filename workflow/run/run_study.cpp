@@ -126,11 +126,14 @@ class WorkerPool {
 };
 
 // Group commit: one write transaction stays open while rows accumulate and
-// is committed when it is `interval` old (or on demand).
+// is committed when it is `interval` old (or on demand). The artifacts the
+// rows refer to are flushed to disk first (one syncfs for all of them: the
+// store runs in Durability::kDeferred mode during a run).
 class BatchWriter {
  public:
-  BatchWriter(Database& database, std::chrono::milliseconds interval)
-      : database_(&database), interval_(interval) {}
+  BatchWriter(Database& database, const ArtifactStore& artifacts,
+              std::chrono::milliseconds interval)
+      : database_(&database), artifacts_(&artifacts), interval_(interval) {}
 
   Database& write() {
     if (!transaction_) {
@@ -141,6 +144,7 @@ class BatchWriter {
   }
   void commit() {
     if (!transaction_) return;
+    artifacts_->sync_all();
     fault_point("run.before_commit");
     transaction_->commit();
     transaction_.reset();
@@ -156,9 +160,28 @@ class BatchWriter {
 
  private:
   Database* database_;
+  const ArtifactStore* artifacts_;
   std::chrono::milliseconds interval_;
   std::optional<Transaction> transaction_;
   Clock::time_point deadline_;
+};
+
+// Puts the store in deferred-sync mode for the lifetime of the object.
+class DeferredSync {
+ public:
+  explicit DeferredSync(ArtifactStore& artifacts)
+      : artifacts_(&artifacts), before_(artifacts.durability()) {
+    artifacts.set_durability(Durability::kDeferred);
+  }
+  ~DeferredSync() { artifacts_->set_durability(before_); }
+  DeferredSync(const DeferredSync&) = delete;
+  DeferredSync& operator=(const DeferredSync&) = delete;
+  DeferredSync(DeferredSync&&) = delete;
+  DeferredSync& operator=(DeferredSync&&) = delete;
+
+ private:
+  ArtifactStore* artifacts_;
+  Durability before_;
 };
 
 std::vector<std::string> declared_outputs_missing(const NodeSpec& spec,
@@ -243,8 +266,9 @@ class Scheduler {
  public:
   Scheduler(Study& study, const RunOptions& options)
       : study_(study),
+        durability_(study.artifacts()),
         options_(options),
-        batch_(study.database(), options.commit_interval),
+        batch_(study.database(), study.artifacts(), options.commit_interval),
         pool_(std::max(1, options.jobs), [this](Job& job) {
           completions_.push(execute(job, study_.artifacts(), scratch_root_, options_.observer));
         }) {}
@@ -447,6 +471,7 @@ class Scheduler {
   }
 
   Study& study_;
+  DeferredSync durability_;
   const RunOptions& options_;
   std::filesystem::path scratch_root_ = study_.scratch_dir();
   RunSummary summary_;

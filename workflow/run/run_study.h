@@ -15,9 +15,10 @@
 //     its dependents whose inputs are now all available become ready
 //   export the workflow's outputs; record the run
 //
-// Crash safety: a node's outputs are durable artifacts (artifact_store.h)
-// before its 'done' row is written, rows are committed in order, and a 'done'
-// row is the only thing that makes a result reusable, so a run killed at any
+// Crash safety: a node's outputs are artifacts (artifact_store.h) flushed to
+// disk before its 'done' row is committed (one syncfs per group commit, the
+// store being in deferred-sync mode during the run), rows are committed in
+// order, and a 'done' row is the only thing that makes a result reusable, so a run killed at any
 // instant leaves a study whose next run redoes exactly the unfinished work.
 // Rows are committed in groups (at most `commit_interval` after the first
 // uncommitted one, and always at the end), which keeps the per-node overhead

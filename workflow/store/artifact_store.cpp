@@ -140,18 +140,19 @@ class TempBlob {
   void write(std::string_view bytes) { write_all(fd_.get(), bytes, path_); }
 
   // Makes the content durable, then atomically gives it its final name.
-  void commit(const std::filesystem::path& root, const std::filesystem::path& final_path) {
+  void commit(const std::filesystem::path& root, const std::filesystem::path& final_path,
+              bool sync) {
     if (::fchmod(fd_.get(), kBlobMode) != 0) {
       throw IoError(path_, "cannot set permissions: " + errno_text(errno));
     }
     fault_point("artifact.before_sync");
-    if (::fsync(fd_.get()) != 0) {
+    if (sync && ::fsync(fd_.get()) != 0) {
       throw IoError(path_, "cannot sync artifact data to disk: " + errno_text(errno));
     }
     fault_point("artifact.before_rename");
     const std::filesystem::path shard = final_path.parent_path();
     if (::mkdir(shard.c_str(), 0755) == 0) {
-      fsync_directory(root);
+      if (sync) fsync_directory(root);
     } else if (errno != EEXIST) {
       throw IoError(shard, "cannot create artifact folder: " + errno_text(errno));
     }
@@ -161,7 +162,7 @@ class TempBlob {
     }
     committed_ = true;
     fault_point("artifact.after_rename");
-    fsync_directory(shard);
+    if (sync) fsync_directory(shard);
   }
 
  private:
@@ -225,7 +226,7 @@ bool ArtifactStore::contains(const std::string& hash) const {
 std::string ArtifactStore::put(std::string_view bytes) {
   std::string hash = hash::sha256_hex(bytes);
   const std::filesystem::path final_path = path_of(hash);
-  if (is_regular_file_of_size(final_path, bytes.size())) return hash;
+  if (is_regular_file_of_size(final_path, bytes.size()) && trust_existing(hash)) return hash;
   TempBlob temp(root_);
   // Fault points: a crash half-way through the bytes must leave only a
   // temporary file behind.
@@ -234,7 +235,7 @@ std::string ArtifactStore::put(std::string_view bytes) {
   temp.write(bytes.substr(0, half));
   fault_point("artifact.mid_write");
   temp.write(bytes.substr(half));
-  temp.commit(root_, final_path);
+  temp.commit(root_, final_path, durability_ == Durability::kSyncEachWrite);
   return hash;
 }
 
@@ -261,7 +262,9 @@ std::string ArtifactStore::put_file(const std::filesystem::path& source) {
   std::string hash = hash::to_hex(hasher.finish());
   const std::filesystem::path final_path = path_of(hash);
   // Already stored: the destructor of `temp` deletes the copy.
-  if (!is_regular_file_of_size(final_path, size)) temp.commit(root_, final_path);
+  if (!is_regular_file_of_size(final_path, size) || !trust_existing(hash)) {
+    temp.commit(root_, final_path, durability_ == Durability::kSyncEachWrite);
+  }
   return hash;
 }
 
@@ -275,6 +278,19 @@ std::string ArtifactStore::get(const std::string& hash) const {
                             " bytes); the study should re-run the node that produced it");
   }
   return content;
+}
+
+bool ArtifactStore::trust_existing(const std::string& hash) const {
+  // A blob of the right size is complete unless it may date from before a
+  // power loss that hit it unsynced (deferred mode): then check its content.
+  return durability_ == Durability::kSyncEachWrite || verify(hash);
+}
+
+void ArtifactStore::sync_all() const {
+  const Fd fd(::open(root_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (!fd.valid() || ::syncfs(fd.get()) != 0) {
+    throw IoError(root_, "cannot flush the artifact store to disk: " + errno_text(errno));
+  }
 }
 
 bool ArtifactStore::verify(const std::string& hash) const {

@@ -87,7 +87,7 @@ class StudyCrashTest : public ::testing::Test {
 
   // A copy of the freshly created (never run) study.
   std::filesystem::path fresh_copy(const std::string& name) {
-    const std::filesystem::path copy = scratch_ / name;
+    std::filesystem::path copy = scratch_ / name;
     std::filesystem::copy(pristine_, copy, std::filesystem::copy_options::recursive);
     return copy;
   }
