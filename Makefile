@@ -21,14 +21,22 @@ LINT_PACKAGES := clang-format clang-tidy
 .PHONY: demo test build deps deps-lint configure bench format lint clean
 
 # The most complete real job that exists today: check, measure and convert
-# every surface of the atlas data (VHF in mm; OpenSim geometry in m, scaled).
+# every surface of the atlas data (VHF in mm; OpenSim geometry in m, scaled),
+# then a study of the example workflow (created once; later runs reuse it).
 demo: build
 	@echo "== mmm demo: survey of the Visible Human Female surfaces =="
 	$(BUILD_DIR)/bin/mmm mesh survey $(DATA_DIR)/vhf --out $(BUILD_DIR)/demo/vhf --lod-faces 2000
 	@echo "== mmm demo: survey of the OpenSim gait2392 bones (m -> mm) =="
 	$(BUILD_DIR)/bin/mmm mesh survey $(DATA_DIR)/gait2392/Geometry --scale 1000 \
 	  --out $(BUILD_DIR)/demo/gait2392
-	@echo "Open $(BUILD_DIR)/demo/*/vtp/*.vtp in ParaView; figures in $(BUILD_DIR)/demo/*/survey.csv"
+	@echo "== mmm demo: a study (schemas/examples/mesh_demo.yaml) on the VHF gluteus medius =="
+	@test -d $(BUILD_DIR)/demo/study || $(BUILD_DIR)/bin/mmm study create $(BUILD_DIR)/demo/study \
+	  --workflow schemas/examples/mesh_demo.yaml \
+	  --input surface=$(DATA_DIR)/vhf/Right/VHF_Right_Muscle_GluteusMedius_smooth.stl
+	$(BUILD_DIR)/bin/mmm run $(BUILD_DIR)/demo/study -j $(JOBS)
+	$(BUILD_DIR)/bin/mmm status $(BUILD_DIR)/demo/study
+	@echo "Open $(BUILD_DIR)/demo/*/vtp/*.vtp and $(BUILD_DIR)/demo/study/outputs/*.ply in ParaView;"
+	@echo "figures in $(BUILD_DIR)/demo/*/survey.csv and $(BUILD_DIR)/demo/study/outputs/report.json"
 
 test: build
 	ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS)
