@@ -30,6 +30,8 @@ std::string_view execution_status_name(ExecutionStatus status);
 struct OutputArtifact {
   PortType type = PortType::kFile;
   std::string hash;
+
+  bool operator==(const OutputArtifact&) const = default;
 };
 
 struct ExecutionRecord {
