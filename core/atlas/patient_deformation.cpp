@@ -1,0 +1,250 @@
+#include "core/atlas/patient_deformation.h"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <set>
+
+#include "core/errors.h"
+#include "core/mesh/aabb_tree.h"
+
+namespace mmm::atlas {
+namespace {
+
+constexpr double kClipSigmas = 2.5;
+
+double draw(std::mt19937_64& random, double sd) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double z = std::clamp(normal(random), -kClipSigmas, kClipSigmas);
+  return 1.0 + sd * z;
+}
+
+// The rotation closest to a linear map (polar decomposition).
+Eigen::Matrix3d rotation_of(const Eigen::Matrix3d& linear) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(linear, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
+  if (rotation.determinant() < 0) {
+    Eigen::Matrix3d u = svd.matrixU();
+    u.col(2) *= -1;
+    rotation = u * svd.matrixV().transpose();
+  }
+  return rotation;
+}
+
+Eigen::Isometry3d map_frame(const Eigen::Affine3d& map, const Eigen::Isometry3d& frame) {
+  Eigen::Isometry3d mapped = Eigen::Isometry3d::Identity();
+  mapped.linear() = rotation_of(map.linear()) * frame.linear();
+  mapped.translation() = map * frame.translation();
+  return mapped;
+}
+
+double length_scale(const Eigen::Affine3d& map) {
+  return std::cbrt(std::abs(map.linear().determinant()));
+}
+
+const Joint* joint_to(const Atlas& atlas, const std::string& child) {
+  for (const Joint& joint : atlas.joints) {
+    if (joint.child == child) return &joint;
+  }
+  return nullptr;
+}
+
+// Bones in an order where each comes after its parent; the root first.
+std::vector<const Bone*> chain_order(const Atlas& atlas, const Bone*& root) {
+  root = nullptr;
+  for (const Bone& bone : atlas.bones) {
+    if (joint_to(atlas, bone.name) == nullptr) {
+      root = &bone;
+      break;
+    }
+  }
+  if (root == nullptr) {
+    throw InvalidInputError(
+        "patient deformation: the atlas has no root bone (every bone hangs "
+        "from a joint)");
+  }
+  std::vector<const Bone*> order{root};
+  std::set<std::string> placed{root->name};
+  bool progress = true;
+  while (progress) {
+    progress = false;
+    for (const Bone& bone : atlas.bones) {
+      if (placed.contains(bone.name)) continue;
+      const Joint* joint = joint_to(atlas, bone.name);
+      if (joint == nullptr || placed.contains(joint->parent)) {
+        order.push_back(&bone);
+        placed.insert(bone.name);
+        progress = true;
+      }
+    }
+  }
+  if (order.size() != atlas.bones.size()) {
+    throw InvalidInputError("patient deformation: some bones are not connected to the root '" +
+                            root->name + "' by joints");
+  }
+  return order;
+}
+
+opensim::Function scaled(const opensim::Function& function, double factor) {
+  return opensim::MultiplierFunction(function, factor);
+}
+
+}  // namespace
+
+Eigen::Vector3d PatientDeformation::map_on_bone(const std::string& bone,
+                                                const Eigen::Vector3d& point) const {
+  const auto map = bone_maps.find(bone);
+  if (map == bone_maps.end()) {
+    throw InvalidInputError("patient deformation: no map for bone '" + bone + "'");
+  }
+  return map->second * point;
+}
+
+PatientDeformation make_patient_deformation(const Atlas& atlas, const PatientOptions& options) {
+  PatientDeformation deformation;
+  PatientFactors& factors = deformation.factors;
+  factors.seed = options.seed;
+  std::mt19937_64 random(options.seed);
+  factors.stature_scale = draw(random, options.stature_sd);
+  if (options.height_mm) factors.stature_scale = *options.height_mm / options.atlas_height_mm;
+  factors.height_mm = factors.stature_scale * options.atlas_height_mm;
+  if (!(factors.height_mm >= 1000.0 && factors.height_mm <= 2300.0)) {
+    throw InvalidInputError("patient height " + std::to_string(factors.height_mm) +
+                            " mm is outside the human range 1000-2300 mm");
+  }
+  factors.pelvis_width = draw(random, options.pelvis_width_sd);
+  // Factors drawn in atlas order, so a seed gives the same patient whatever
+  // the joint layout.
+  for (const Bone& bone : atlas.bones) {
+    factors.length[bone.name] = draw(random, options.segment_length_sd);
+    factors.width[bone.name] = draw(random, options.width_sd);
+  }
+  const double s = factors.stature_scale;
+
+  const Bone* root = nullptr;
+  for (const Bone* bone : chain_order(atlas, root)) {
+    const Joint* joint = joint_to(atlas, bone->name);
+    Eigen::Affine3d map = Eigen::Affine3d::Identity();
+    if (joint == nullptr) {
+      // The root, or a bone without a joint: scales about the root's origin.
+      const Eigen::Vector3d origin = root->frame.translation();
+      Eigen::Matrix3d linear = s * Eigen::Matrix3d::Identity();
+      linear(0, 0) *= factors.pelvis_width;
+      map.linear() = linear;
+      map.translation() = origin - linear * origin;
+      if (bone != root) map = deformation.bone_maps.at(root->name);
+    } else if (joint->type == JointType::kWeld) {
+      map = deformation.bone_maps.at(joint->parent);
+    } else {
+      const Eigen::Vector3d proximal = joint->child_frame.translation();
+      Eigen::Vector3d distal = Eigen::Vector3d::Zero();
+      int distal_count = 0;
+      for (const Joint& child : atlas.joints) {
+        if (child.parent == bone->name && child.type != JointType::kWeld) {
+          distal += child.parent_frame.translation();
+          ++distal_count;
+        }
+      }
+      const double length = factors.length.at(bone->name);
+      const double width = factors.width.at(bone->name);
+      Eigen::Matrix3d linear = s * length * Eigen::Matrix3d::Identity();
+      if (distal_count > 0 && (distal / distal_count - proximal).norm() > 1.0) {
+        const Eigen::Vector3d axis = (distal / distal_count - proximal).normalized();
+        const Eigen::Matrix3d along = axis * axis.transpose();
+        linear = s * (length * along + width * (Eigen::Matrix3d::Identity() - along));
+      }
+      const Eigen::Vector3d moved = deformation.bone_maps.at(joint->parent) * proximal;
+      map.linear() = linear;
+      map.translation() = moved - linear * proximal;
+    }
+    deformation.bone_maps[bone->name] = map;
+  }
+  return deformation;
+}
+
+Atlas deform_atlas(const Atlas& atlas, const PatientDeformation& deformation) {
+  Atlas patient = atlas;
+  const auto& maps = deformation.bone_maps;
+  for (Bone& bone : patient.bones) bone.frame = map_frame(maps.at(bone.name), bone.frame);
+  for (Joint& joint : patient.joints) {
+    const Eigen::Affine3d& parent = maps.at(joint.parent);
+    joint.parent_frame = map_frame(parent, joint.parent_frame);
+    joint.child_frame = map_frame(maps.at(joint.child), joint.child_frame);
+    for (TransformAxis& axis : joint.axes) {
+      if (!axis.rotation) axis.function = scaled(axis.function, length_scale(parent));
+    }
+  }
+  for (Muscle& muscle : patient.muscles) {
+    for (ActionLine& line : muscle.action_lines) {
+      for (PathPoint& point : line.points) {
+        const Eigen::Affine3d& map = maps.at(point.bone);
+        point.position = map * point.position;
+        if (point.kind == PathPointKind::kMoving) {
+          for (opensim::Function& function : point.moving_functions) {
+            function = scaled(function, length_scale(map));
+          }
+        }
+      }
+    }
+    for (auto* areas : {&muscle.origins, &muscle.insertions}) {
+      for (AttachmentArea& area : *areas) {
+        const Eigen::Affine3d& map = maps.at(area.bone);
+        area.centroid = map * area.centroid;
+        area.area_mm2 *= std::pow(length_scale(map), 2);
+      }
+    }
+    for (WrapObstacle& obstacle : muscle.wrap_obstacles) {
+      const Eigen::Affine3d& map = maps.at(obstacle.bone);
+      obstacle.pose = map_frame(map, obstacle.pose);
+      obstacle.radii *= length_scale(map);
+    }
+  }
+  for (Landmark& landmark : patient.landmarks) {
+    landmark.position = deformation.map_on_bone(landmark.bone, landmark.position);
+  }
+  for (Marker& marker : patient.markers) {
+    marker.position = deformation.map_on_bone(marker.bone, marker.position);
+  }
+  patient.provenance.push_back("synthetic patient: seed " +
+                               std::to_string(deformation.factors.seed) + ", height " +
+                               std::to_string(deformation.factors.height_mm) + " mm");
+  return patient;
+}
+
+mesh::IndexedMesh deform_bone_mesh(const PatientDeformation& deformation, const std::string& bone,
+                                   const mesh::IndexedMesh& surface) {
+  mesh::IndexedMesh mapped = surface;
+  const Eigen::Affine3d& map = deformation.bone_maps.at(bone);
+  for (Eigen::Index i = 0; i < mapped.V.rows(); ++i) {
+    mapped.V.row(i) = (map * Eigen::Vector3d(surface.V.row(i))).transpose();
+  }
+  return mapped;
+}
+
+mesh::IndexedMesh deform_muscle_mesh(const PatientDeformation& deformation,
+                                     const std::map<std::string, mesh::IndexedMesh>& bones,
+                                     const mesh::IndexedMesh& surface, double blend_radius_mm) {
+  if (bones.empty()) throw InvalidInputError("deform_muscle_mesh: no bone surfaces given");
+  std::vector<std::pair<const Eigen::Affine3d*, mesh::AabbTree>> trees;
+  trees.reserve(bones.size());
+  for (const auto& [name, bone] : bones) {
+    trees.emplace_back(&deformation.bone_maps.at(name), mesh::AabbTree(bone));
+  }
+  const double eps2 = blend_radius_mm * blend_radius_mm;
+  mesh::IndexedMesh mapped = surface;
+  for (Eigen::Index i = 0; i < surface.V.rows(); ++i) {
+    const Eigen::Vector3d p = surface.V.row(i).transpose();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double total = 0.0;
+    for (const auto& [map, tree] : trees) {
+      const double weight = 1.0 / (tree.closest_point(p).squared_distance + eps2);
+      sum += weight * (*map * p);
+      total += weight;
+    }
+    mapped.V.row(i) = (sum / total).transpose();
+  }
+  return mapped;
+}
+
+}  // namespace mmm::atlas

@@ -1,0 +1,86 @@
+#pragma once
+// A known, anatomically plausible non-uniform deformation of an atlas: the
+// ground truth of a synthetic patient.
+//
+// Each bone gets an affine map anchored at its proximal joint centre:
+//   map_b(x) = c'_b + s * (I + (l_b - 1) a a^T + (w_b - 1) (I - a a^T)) (x - c_b)
+// with c_b the centre of the joint attaching b to its parent, a the unit
+// axis from c_b to the centre of b's distal joint (its long axis), s the
+// global scale (stature), l_b the segment-length factor and w_b the width
+// factor. c'_b = map_parent(c_b) keeps the chain connected. The root (the
+// pelvis) scales about its frame origin, its width (x, mediolateral) by the
+// pelvis-width factor. A bone welded to another follows that bone's map.
+// Muscles, which span several bones, move by a partition of unity of the
+// bone maps, weighted by inverse squared distance to each bone's surface
+// (w = 1 / (d^2 + eps^2)), so they stretch smoothly with the segments they
+// lie along. Landmarks, markers, action-line points, attachment-area
+// centroids, wrap obstacles and joint frames follow their bone's map.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <random>
+#include <string>
+
+#include "core/atlas/atlas.h"
+#include "core/mesh/mesh.h"
+
+namespace mmm::atlas {
+
+struct PatientOptions {
+  std::uint64_t seed = 1;
+  // Target stature (mm); when absent, drawn around the atlas's own.
+  std::optional<double> height_mm;
+  // Stature of the atlas subject (the Visible Human Female: 1.71 m).
+  double atlas_height_mm = 1710.0;
+  // Standard deviations of the factors (relative), drawn from normal
+  // distributions clipped at 2.5 sigma (human ranges: adult segment-length
+  // ratios vary by a few percent at fixed stature, widths by more).
+  double stature_sd = 0.06;
+  double segment_length_sd = 0.03;
+  double width_sd = 0.05;
+  double pelvis_width_sd = 0.05;
+  // Muscle blending: eps in w = 1 / (d^2 + eps^2) (mm).
+  double blend_radius_mm = 10.0;
+};
+
+// The drawn factors, kept with the patient as its ground truth.
+struct PatientFactors {
+  std::uint64_t seed = 0;
+  double height_mm = 0.0;
+  double stature_scale = 1.0;
+  double pelvis_width = 1.0;
+  std::map<std::string, double> length;  // bone -> segment-length factor
+  std::map<std::string, double> width;   // bone -> width factor
+};
+
+// The deformation: one affine map per bone (atlas mm -> patient mm).
+struct PatientDeformation {
+  PatientFactors factors;
+  std::map<std::string, Eigen::Affine3d> bone_maps;
+
+  [[nodiscard]] Eigen::Vector3d map_on_bone(const std::string& bone,
+                                            const Eigen::Vector3d& point) const;
+};
+
+// Draws the factors (deterministic for a seed) and builds the maps. Throws
+// InvalidInputError for an atlas without a root bone or with a joint whose
+// bones are unknown, or a height outside 1000-2300 mm.
+PatientDeformation make_patient_deformation(const Atlas& atlas, const PatientOptions& options);
+
+// The deformed atlas: every point-like element mapped (names, tags and
+// structure unchanged; mesh file names unchanged — the caller writes the
+// deformed meshes with deform_bone_mesh / deform_muscle_mesh).
+Atlas deform_atlas(const Atlas& atlas, const PatientDeformation& deformation);
+
+// A bone's mesh mapped by its bone map.
+mesh::IndexedMesh deform_bone_mesh(const PatientDeformation& deformation, const std::string& bone,
+                                   const mesh::IndexedMesh& surface);
+
+// A muscle's mesh mapped by the distance-weighted blend of the bone maps;
+// `bones` are the atlas's bone surfaces (any resolution) by name.
+mesh::IndexedMesh deform_muscle_mesh(const PatientDeformation& deformation,
+                                     const std::map<std::string, mesh::IndexedMesh>& bones,
+                                     const mesh::IndexedMesh& surface, double blend_radius_mm);
+
+}  // namespace mmm::atlas

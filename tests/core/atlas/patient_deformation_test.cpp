@@ -1,0 +1,127 @@
+#include "core/atlas/patient_deformation.h"
+
+#include <gtest/gtest.h>
+
+#include "core/errors.h"
+#include "core/mesh/mass_properties.h"
+#include "core/mesh/primitives.h"
+
+namespace mmm::atlas {
+namespace {
+
+Joint joint_between(const std::string& name, const std::string& parent, const std::string& child,
+                    const Eigen::Vector3d& centre, JointType type = JointType::kPin) {
+  Joint joint;
+  joint.name = name;
+  joint.type = type;
+  joint.parent = parent;
+  joint.child = child;
+  joint.parent_frame.translation() = centre;
+  joint.child_frame.translation() = centre;
+  return joint;
+}
+
+Bone bone_named(const std::string& name, const std::string& parent_joint) {
+  Bone bone;
+  bone.name = name;
+  bone.parent_joint = parent_joint;
+  return bone;
+}
+
+PatientOptions seeded(std::uint64_t seed, std::optional<double> height_mm = std::nullopt) {
+  PatientOptions options;
+  options.seed = seed;
+  options.height_mm = height_mm;
+  return options;
+}
+
+// pelvis (root, origin at 0) -hip (0,0,-50)-> thigh -knee (0,0,-450)-> shank
+// -ankle (0,0,-850)-> foot; a kneecap welded to the shank.
+Atlas leg() {
+  Atlas atlas;
+  atlas.bones = {bone_named("pelvis", ""), bone_named("thigh", "hip"), bone_named("shank", "knee"),
+                 bone_named("foot", "ankle"), bone_named("kneecap", "patellar")};
+  atlas.joints = {joint_between("hip", "pelvis", "thigh", {0, 0, -50}),
+                  joint_between("knee", "thigh", "shank", {0, 0, -450}),
+                  joint_between("ankle", "shank", "foot", {0, 0, -850}),
+                  joint_between("patellar", "shank", "kneecap", {0, 30, -440}, JointType::kWeld)};
+  Landmark knee_centre;
+  knee_centre.name = "knee_centre";
+  knee_centre.bone = "shank";
+  knee_centre.position = {0, 0, -450};
+  atlas.landmarks.push_back(knee_centre);
+  return atlas;
+}
+
+TEST(PatientDeformationTest, SegmentsScaleByTheirFactorsAndStayConnected) {
+  const Atlas atlas = leg();
+  const PatientDeformation deformation = make_patient_deformation(atlas, seeded(7));
+  const PatientFactors& f = deformation.factors;
+  const auto on = [&](const std::string& bone, const Eigen::Vector3d& p) {
+    return deformation.map_on_bone(bone, p);
+  };
+  const Eigen::Vector3d hip(0, 0, -50);
+  const Eigen::Vector3d knee(0, 0, -450);
+  const Eigen::Vector3d ankle(0, 0, -850);
+  // Joint centres map to the same place from both sides (1e-9 mm: rounding).
+  EXPECT_LT((on("pelvis", hip) - on("thigh", hip)).norm(), 1e-9);
+  EXPECT_LT((on("thigh", knee) - on("shank", knee)).norm(), 1e-9);
+  EXPECT_LT((on("shank", ankle) - on("foot", ankle)).norm(), 1e-9);
+  // Segment lengths: 400 mm each, times stature and segment factors.
+  EXPECT_NEAR((on("thigh", knee) - on("thigh", hip)).norm(),
+              400 * f.stature_scale * f.length.at("thigh"), 1e-9);
+  EXPECT_NEAR((on("shank", ankle) - on("shank", knee)).norm(),
+              400 * f.stature_scale * f.length.at("shank"), 1e-9);
+  // Widths: a point 20 mm off the thigh axis moves to 20 * s * w.
+  const Eigen::Vector3d side =
+      on("thigh", Eigen::Vector3d(20, 0, -250)) - on("thigh", Eigen::Vector3d(0, 0, -250));
+  EXPECT_NEAR(side.norm(), 20 * f.stature_scale * f.width.at("thigh"), 1e-9);
+  // The welded kneecap follows the shank.
+  EXPECT_TRUE(deformation.bone_maps.at("kneecap").isApprox(deformation.bone_maps.at("shank")));
+  // Factors stay within 2.5 sigma of 1.
+  for (const auto& [bone, length] : f.length) EXPECT_NEAR(length, 1.0, 2.5 * 0.03 + 1e-12) << bone;
+}
+
+TEST(PatientDeformationTest, SameSeedSamePatientAndHeightIsHonoured) {
+  const Atlas atlas = leg();
+  const PatientDeformation a = make_patient_deformation(atlas, seeded(3));
+  const PatientDeformation b = make_patient_deformation(atlas, seeded(3));
+  const PatientDeformation c = make_patient_deformation(atlas, seeded(4));
+  EXPECT_EQ(a.factors.length, b.factors.length);
+  EXPECT_NE(a.factors.length, c.factors.length);
+  const PatientDeformation tall = make_patient_deformation(atlas, seeded(3, 1881.0));
+  EXPECT_DOUBLE_EQ(tall.factors.stature_scale, 1881.0 / 1710.0);
+  EXPECT_THROW(make_patient_deformation(atlas, seeded(3, 400.0)), InvalidInputError);
+}
+
+TEST(PatientDeformationTest, DeformedAtlasMovesLandmarksAndJointFrames) {
+  const Atlas atlas = leg();
+  const PatientDeformation deformation = make_patient_deformation(atlas, seeded(11));
+  const Atlas patient = deform_atlas(atlas, deformation);
+  const Eigen::Vector3d expected = deformation.map_on_bone("shank", {0, 0, -450});
+  EXPECT_LT((patient.find_landmark("knee_centre")->position - expected).norm(), 1e-9);
+  EXPECT_LT((patient.find_joint("knee")->child_frame.translation() - expected).norm(), 1e-9);
+  // Frames stay rigid (orthonormal rotations).
+  const Eigen::Matrix3d r = patient.find_joint("knee")->parent_frame.linear();
+  EXPECT_TRUE((r * r.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+}
+
+TEST(PatientDeformationTest, MuscleBetweenTwoBonesBlendsTheirMaps) {
+  const Atlas atlas = leg();
+  const PatientDeformation deformation = make_patient_deformation(atlas, seeded(5));
+  // A sphere sitting on the thigh's axis far from the shank follows the
+  // thigh map almost exactly.
+  const mesh::IndexedMesh thigh_bone = mesh::make_box({-10, -10, -440}, {10, 10, -60});
+  const mesh::IndexedMesh shank_bone = mesh::make_box({-10, -10, -840}, {10, 10, -460});
+  const mesh::IndexedMesh muscle = mesh::make_icosphere(2, 15.0, {25, 0, -150});
+  const mesh::IndexedMesh moved =
+      deform_muscle_mesh(deformation, {{"thigh", thigh_bone}, {"shank", shank_bone}}, muscle, 10.0);
+  const mesh::IndexedMesh by_thigh = deform_bone_mesh(deformation, "thigh", muscle);
+  // Within 0.5 mm: the shank's weight there is (d_thigh^2 + 100) / (d_shank^2 + 100)
+  // ~ 1e-3 of the thigh's, times a few mm of difference between the maps.
+  EXPECT_LT((moved.V - by_thigh.V).rowwise().norm().maxCoeff(), 0.5);
+  EXPECT_GT(mesh::signed_volume(moved), 0.0);
+}
+
+}  // namespace
+}  // namespace mmm::atlas
