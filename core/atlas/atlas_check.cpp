@@ -105,7 +105,7 @@ AtlasCheckReport check_atlas(const std::filesystem::path& dir, const AtlasCheckO
   try {
     atlas = read_atlas(dir);
   } catch (const std::exception& e) {
-    report.problems.push_back(e.what());
+    report.problems.emplace_back(e.what());
     return report;
   }
   for (const std::string_view name : kRequiredLandmarks) {
