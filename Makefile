@@ -12,7 +12,7 @@ SUITE      ?= mesh
 # Debian 12 packages needed to build, test and benchmark mmm.
 APT_PACKAGES := build-essential cmake ninja-build pkg-config python3 \
   libeigen3-dev libopenmesh-dev libceres-dev libyaml-cpp-dev libspdlog-dev libfmt-dev \
-  libtinyxml2-dev nlohmann-json3-dev libcli11-dev libsqlite3-dev \
+  libtinyxml2-dev nlohmann-json3-dev libcli11-dev libsqlite3-dev zlib1g-dev \
   libgtest-dev libgmock-dev googletest libbenchmark-dev
 # Extra tools used by .ci/run (format and static analysis).
 LINT_PACKAGES := clang-format clang-tidy
