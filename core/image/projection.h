@@ -1,0 +1,152 @@
+#pragma once
+// Calibrated X-ray views of a biplanar (EOS-like) radiography system: the
+// pinhole model of each view, projection of 3-D points, linear triangulation
+// of a point seen in two or more views, and the JSON sidecar that stores a
+// calibrated pair beside its images.
+//
+// Model: a view is a 3 x 4 matrix P with [u v 1]^T ~ P [X 1]^T (Hartley &
+// Zisserman, "Multiple View Geometry", 2nd ed., ch. 6); the X-ray focal spot
+// is the centre of projection (P [source 1]^T = 0). Real EOS scanners are
+// conic horizontally but parallel vertically (source and detector move up
+// together); a pinhole matrix fitted to their calibration is the usual
+// approximation, exact for the views make_biplanar_views builds.
+//
+// Triangulation (linear, "DLT"): each view gives two equations linear in X,
+//   (u p3 - p1) . [X 1] = 0,   (v p3 - p2) . [X 1] = 0   (p_i = row i of P),
+// solved in least squares for the 3 coordinates. The residual of such a row
+// is depth * (pixel error); a second solve divides each view's rows by the
+// depth found by the first and multiplies them by the view's pixel spacing,
+// so that every equation measures an error in mm at the isocentre and views
+// of different resolution weigh what they are worth (the iterative linear
+// method of Hartley & Sturm 1997, "Triangulation", one step).
+//
+// Conventions (all of mmm's image code):
+//   world   the patient frame in mm: +x toward the subject's right, +y
+//           anterior, +z superior (right-handed; "RAS").
+//   pixels  (u, v): u to the right along a row, v down along a column. Pixel
+//           (i, j) (column i, row j) covers [i, i+1) x [j, j+1), so its centre
+//           is (i + 0.5, j + 0.5) and the image spans [0, width] x [0, height].
+//   frontal beam anterior -> posterior (AP: source in front of the subject,
+//           detector behind); the image is seen from the source, as
+//           radiologists display a frontal film: the subject's right on the
+//           image left, u increasing toward the subject's left (-x), v down
+//           (-z).
+//   lateral beam right -> left (-x: source on the subject's right, detector on
+//           the left); seen from the source: anterior on the image right, u
+//           increasing toward anterior (+y), v down (-z).
+
+#include <Eigen/Core>
+#include <array>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace mmm::image {
+
+struct RadiographView {
+  std::string name;  // "frontal", "lateral", ...
+  // Maps homogeneous world points (mm) to homogeneous pixels (u, v, 1) up to
+  // scale; pixel centres at integer + 0.5 (see above).
+  Eigen::Matrix<double, 3, 4> P = Eigen::Matrix<double, 3, 4>::Zero();
+  int width = 0;   // pixels (u in [0, width])
+  int height = 0;  // pixels (v in [0, height])
+  // Size of a pixel projected onto the plane through the isocentre parallel
+  // to the detector (mm): the detector pitch divided by the magnification
+  // source_to_detector / source_to_isocentre. An object at the isocentre
+  // measures this many mm per pixel.
+  double pixel_spacing_mm = 0;
+  // X-ray focal spot (mm, world): the centre of projection of P.
+  Eigen::Vector3d source_mm = Eigen::Vector3d::Zero();
+};
+
+// A ray in world coordinates: origin + t * direction, t >= 0.
+struct Ray {
+  Eigen::Vector3d origin;     // mm
+  Eigen::Vector3d direction;  // unit length
+};
+
+struct BiplanarOptions {
+  // World point on both central rays (mm): the centre of the field, where the
+  // two beams cross. Default: the world origin.
+  Eigen::Vector3d isocentre_mm = Eigen::Vector3d::Zero();
+  // Focal spot to isocentre (mm). 1300 mm is a round figure of the order of
+  // EOS-type systems (not a vendor specification).
+  double source_to_isocentre_mm = 1300.0;
+  // Focal spot to detector (mm), > source_to_isocentre_mm; with the default
+  // 1700 mm the magnification at the isocentre is 1700 / 1300 = 1.31.
+  double source_to_detector_mm = 1700.0;
+  // Detector pixel pitch (mm), in the plane of the detector. 0.3 mm (the
+  // views' spacing at the isocentre is then 0.3 / 1.31 = 0.229 mm).
+  double detector_pixel_pitch_mm = 0.3;
+  // Field of view at the isocentre (mm): horizontal (x for the frontal view,
+  // y for the lateral one) and vertical (z). 450 x 1100 mm covers the pelvis
+  // to the feet of an adult. The image size is this over the pixel spacing at
+  // the isocentre, rounded to the nearest pixel.
+  double field_width_mm = 450.0;
+  double field_height_mm = 1100.0;
+};
+
+// The calibrated pair {frontal, lateral} described by `options` (names
+// "frontal" and "lateral"). The isocentre projects to the image centre
+// (width / 2, height / 2) of both. Throws InvalidInputError naming the field
+// for a non-finite or non-positive value, source_to_detector_mm <=
+// source_to_isocentre_mm, or an image larger than 100000 pixels a side.
+std::array<RadiographView, 2> make_biplanar_views(const BiplanarOptions& options = {});
+
+// Throws InvalidInputError naming the view and field unless: P is finite and
+// its left 3 x 3 block invertible, width and height are >= 1, the spacing is
+// finite and > 0, source_mm is finite and is the centre of projection of P
+// (within 1e-6 of the source-to-isocentre scale, i.e. to rounding).
+void validate_view(const RadiographView& view);
+
+// Pixel (u, v) of the world point X (mm). Throws InvalidInputError when X is
+// not finite or lies on or behind the plane through the source parallel to
+// the detector (it casts no shadow on the detector).
+Eigen::Vector2d project(const RadiographView& view, const Eigen::Vector3d& X);
+
+// The ray from the source through pixel position (u, v), pointing toward the
+// detector. Throws InvalidInputError for a non-finite pixel or a view whose
+// P is singular.
+Ray backproject(const RadiographView& view, const Eigen::Vector2d& pixel);
+
+// Least-squares linear triangulation of one point seen at pixels[i] in
+// views[i] (see the file comment). Returns X (mm). Throws InvalidInputError
+// when fewer than 2 views are given, the counts differ, a pixel is not finite,
+// a view fails validate_view, or the geometry is degenerate (the rays are
+// parallel within ~1e-9 rad, e.g. the same view twice).
+Eigen::Vector3d triangulate_linear(std::span<const RadiographView> views,
+                                   std::span<const Eigen::Vector2d> pixels);
+
+// Distance between the projection of X and `pixel`, in pixels times the
+// view's pixel_spacing_mm: mm at the isocentre plane.
+double reprojection_error_mm(const RadiographView& view, const Eigen::Vector3d& X,
+                             const Eigen::Vector2d& pixel);
+
+// One view as stored in a sidecar, with the file name of its radiograph
+// (relative to the sidecar's folder, e.g. "frontal.png").
+struct RadiographFile {
+  RadiographView view;
+  std::string image;
+};
+
+// Writes the views as JSON:
+//   {"format": "mmm-radiograph-views", "version": 1,
+//    "views": [{"name": "frontal", "image": "frontal.png", "width": 1962,
+//               "height": 4796, "pixel_spacing_mm": 0.229,
+//               "source_mm": [x, y, z], "P": [[4 numbers], [..], [..]]}, ...]}
+// Numbers are written with 17 significant digits, so reading gives back the
+// same doubles. Throws InvalidInputError when no view is given, a view fails
+// validate_view, names are empty or repeated, or an image name is empty;
+// IoError naming the path when the file cannot be written.
+void write_view_sidecar(const std::filesystem::path& path, std::span<const RadiographFile> views);
+
+// Reads a sidecar written by write_view_sidecar. Every field is checked; an
+// error is an IoError naming the path and the field, e.g.
+// "views[1] ('lateral'): field 'P' must be 3 rows of 4 finite numbers, row 2
+// has 3 entries", "views[0] ('frontal'): field 'pixel_spacing_mm' is missing".
+// Unknown extra fields are ignored (room for later versions); a version other
+// than 1 is rejected.
+std::vector<RadiographFile> read_view_sidecar(const std::filesystem::path& path);
+
+}  // namespace mmm::image
