@@ -97,7 +97,8 @@ std::array<RadiographView, 2> make_biplanar_views(const BiplanarOptions& options
 // Throws InvalidInputError naming the view and field unless: P is finite and
 // its left 3 x 3 block invertible, width and height are >= 1, the spacing is
 // finite and > 0, source_mm is finite and is the centre of projection of P
-// (within 1e-6 of the source-to-isocentre scale, i.e. to rounding).
+// (-M^-1 p4 for P = [M | p4]) within 1e-6 * (1 mm + its distance from the
+// origin): rounding, not a second focal spot.
 void validate_view(const RadiographView& view);
 
 // Pixel (u, v) of the world point X (mm). Throws InvalidInputError when X is
@@ -113,8 +114,9 @@ Ray backproject(const RadiographView& view, const Eigen::Vector2d& pixel);
 // Least-squares linear triangulation of one point seen at pixels[i] in
 // views[i] (see the file comment). Returns X (mm). Throws InvalidInputError
 // when fewer than 2 views are given, the counts differ, a pixel is not finite,
-// a view fails validate_view, or the geometry is degenerate (the rays are
-// parallel within ~1e-9 rad, e.g. the same view twice).
+// a view fails validate_view, or the geometry is degenerate: every pair of
+// rays within 1e-6 rad of parallel (e.g. the same view twice), where a pixel
+// of error would move the point by a million pixel sizes along the rays.
 Eigen::Vector3d triangulate_linear(std::span<const RadiographView> views,
                                    std::span<const Eigen::Vector2d> pixels);
 
@@ -133,10 +135,10 @@ struct RadiographFile {
 // Writes the views as JSON:
 //   {"format": "mmm-radiograph-views", "version": 1,
 //    "views": [{"name": "frontal", "image": "frontal.png", "width": 1962,
-//               "height": 4796, "pixel_spacing_mm": 0.229,
+//               "height": 4795, "pixel_spacing_mm": 0.229,
 //               "source_mm": [x, y, z], "P": [[4 numbers], [..], [..]]}, ...]}
-// Numbers are written with 17 significant digits, so reading gives back the
-// same doubles. Throws InvalidInputError when no view is given, a view fails
+// Numbers are written as the shortest text that reads back to the same
+// double, so a round trip is exact. Throws InvalidInputError when no view is given, a view fails
 // validate_view, names are empty or repeated, or an image name is empty;
 // IoError naming the path when the file cannot be written.
 void write_view_sidecar(const std::filesystem::path& path, std::span<const RadiographFile> views);
