@@ -265,11 +265,15 @@ class ManifestWriter {
     block_list(atlas.markers, [&](const Marker& marker) { write_marker(marker); });
     out_ << YAML::EndMap;
     if (!out_.good()) throw std::logic_error("atlas manifest emitter: " + out_.GetLastError());
-    return std::string(out_.c_str()) + "\n";
+    return "# mmm atlas manifest: structure in schemas/atlas.schema.yaml; atlas frame, mm, rad\n" +
+           std::string(out_.c_str()) + "\n";
   }
 
  private:
   void key(const char* name) { out_ << YAML::Key << name << YAML::Value; }
+
+  // A list of elements, one per line; an empty one as [].
+  void begin_list(bool empty) { out_ << (empty ? YAML::Flow : YAML::Block) << YAML::BeginSeq; }
 
   void text(const std::string& value) {
     if (needs_quotes(value)) out_ << YAML::DoubleQuoted;
@@ -280,13 +284,13 @@ class ManifestWriter {
 
   template <class T, class WriteItem>
   void block_list(const std::vector<T>& items, WriteItem write_item) {
-    out_ << YAML::Block << YAML::BeginSeq;
+    begin_list(items.empty());
     for (const T& item : items) write_item(item);
     out_ << YAML::EndSeq;
   }
 
   void block_texts(const std::vector<std::string>& values) {
-    out_ << YAML::Block << YAML::BeginSeq;
+    begin_list(values.empty());
     for (const std::string& value : values) text(value);
     out_ << YAML::EndSeq;
   }
@@ -371,7 +375,7 @@ class ManifestWriter {
   }
 
   void mesh_levels(const std::vector<MeshLevel>& levels) {
-    out_ << YAML::Block << YAML::BeginSeq;
+    begin_list(levels.empty());
     for (const MeshLevel& level : levels) {
       out_ << YAML::Flow << YAML::BeginMap;
       key("level");
@@ -430,7 +434,7 @@ class ManifestWriter {
     key("child_frame");
     frame(joint.child_frame);
     key("coordinates");
-    out_ << YAML::Block << YAML::BeginSeq;
+    begin_list(joint.coordinates.empty());
     for (const Coordinate& coordinate : joint.coordinates) {
       out_ << YAML::Flow << YAML::BeginMap;
       key("name");
@@ -448,7 +452,7 @@ class ManifestWriter {
     out_ << YAML::EndSeq;
     if (joint.type == JointType::kCustom || !joint.axes.empty()) {
       key("axes");
-      out_ << YAML::Block << YAML::BeginSeq;
+      begin_list(joint.axes.empty());
       for (const TransformAxis& axis : joint.axes) {
         out_ << YAML::Flow << YAML::BeginMap;
         key("kind");
@@ -468,10 +472,14 @@ class ManifestWriter {
     out_ << YAML::EndMap;
   }
 
+  // Fixed and conditional points on one line each; moving ones as a block.
   void write_point(const PathPoint& point) {
+    if (point.kind != PathPointKind::kMoving) out_ << YAML::Flow;
     out_ << YAML::BeginMap;
-    key("name");
-    text(point.name);
+    if (!point.name.empty()) {
+      key("name");
+      text(point.name);
+    }
     key("bone");
     text(point.bone);
     key("position");
@@ -504,7 +512,7 @@ class ManifestWriter {
   }
 
   void attachment_areas(const std::vector<AttachmentArea>& areas) {
-    out_ << YAML::Block << YAML::BeginSeq;
+    begin_list(areas.empty());
     for (const AttachmentArea& area : areas) {
       out_ << YAML::BeginMap;
       key("bone");
@@ -541,7 +549,7 @@ class ManifestWriter {
     key("pennation_angle_rad");
     number(muscle.pennation_angle_rad);
     key("wrap_obstacles");
-    out_ << YAML::Block << YAML::BeginSeq;
+    begin_list(muscle.wrap_obstacles.empty());
     for (const WrapObstacle& obstacle : muscle.wrap_obstacles) {
       out_ << YAML::BeginMap;
       key("name");
@@ -560,7 +568,7 @@ class ManifestWriter {
     }
     out_ << YAML::EndSeq;
     key("action_lines");
-    out_ << YAML::Block << YAML::BeginSeq;
+    begin_list(muscle.action_lines.empty());
     for (const ActionLine& line : muscle.action_lines) {
       out_ << YAML::BeginMap;
       key("name");
