@@ -1716,6 +1716,7 @@ mesh::IndexedMesh load_mesh(const std::filesystem::path& dir, const std::vector<
   const auto it = std::ranges::find(meshes, wanted, &MeshLevel::level);
   if (it == meshes.end()) {
     std::vector<std::string> levels;
+    levels.reserve(meshes.size());
     for (const MeshLevel& m : meshes) levels.push_back(m.level);
     throw IoError(dir / kManifestFile,
                   "no mesh level '" + wanted + "' (levels: " + join_names(levels) + ")");

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/atlas/atlas_check.h"
 #include "core/errors.h"
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/primitives.h"
@@ -533,6 +534,22 @@ TEST(AtlasIoTest, LoadMeshRejectsAFaceCountThatDisagreesWithTheManifest) {
                   HasSubstr("has 320 triangles, but the atlas manifest says 321 (level 'full')")));
   levels[0].file = "meshes/nowhere.ply";
   EXPECT_THROW((void)load_mesh(dir.path(), levels), IoError);
+}
+
+TEST(AtlasIoTest, AtlasCheckReadsTheWrittenAtlasAndEveryMeshLevel) {
+  const test::ScratchDir dir("atlas_io_check");
+  write_atlas_manifest(synthetic_atlas(dir.path()), dir.path());
+  const AtlasCheckReport report = check_atlas(dir.path());
+  // pelvis 1 level, femur_r 2, tibia_r 1, the muscle 1.
+  ASSERT_EQ(report.meshes.size(), 5U);
+  for (const MeshHealth& health : report.meshes) {
+    EXPECT_TRUE(health.closed && health.manifold && health.oriented)
+        << health.element << " " << health.level;
+  }
+  for (const std::string& problem : report.problems) {
+    EXPECT_THAT(problem, Not(HasSubstr("atlas.yaml"))) << "the manifest must read";
+    EXPECT_THAT(problem, Not(HasSubstr("no mesh level")));
+  }
 }
 
 TEST(AtlasIoTest, MissingManifestIsAnIoErrorNamingTheFile) {
