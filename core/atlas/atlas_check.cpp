@@ -17,6 +17,11 @@
 namespace mmm::atlas {
 namespace {
 
+// The fibre part of a path is never taken as less than this share of it
+// (a tendon slack length above the path length, possible at rest, would
+// otherwise make any line pass).
+constexpr double kLeastFibrePart = 0.25;
+
 std::string number_text(double value, int decimals) {
   std::ostringstream text;
   text.setf(std::ios::fixed);
@@ -161,12 +166,28 @@ AtlasCheckReport check_atlas(const std::filesystem::path& dir, const AtlasCheckO
         line_check.length_mm += (polyline[i] - polyline[i - 1]).norm();
       }
       line_check.inside_fraction = inside_fraction(polyline, options.sample_step_mm, inside);
-      check.min_inside_fraction = std::min(check.min_inside_fraction, line_check.inside_fraction);
-      if (line_check.inside_fraction < options.min_inside_fraction) {
-        report.problems.push_back(
-            muscle.name + ": action line " + line.name + " is " +
-            number_text(100 * line_check.inside_fraction, 1) + "% inside the muscle (at least " +
-            number_text(100 * options.min_inside_fraction, 0) + "% required)");
+      // The tendon is not part of a muscle surface: what must lie inside is
+      // the fibre part of the path, its length less the tendon's.
+      line_check.tendon_mm = std::clamp(muscle.tendon_slack_length_mm, 0.0,
+                                        (1.0 - kLeastFibrePart) * line_check.length_mm);
+      const double fibre_part = line_check.length_mm - line_check.tendon_mm;
+      line_check.fibre_part_inside_fraction =
+          fibre_part > 0
+              ? std::min(1.0, line_check.inside_fraction * line_check.length_mm / fibre_part)
+              : line_check.inside_fraction;
+      check.min_inside_fraction =
+          std::min(check.min_inside_fraction, line_check.fibre_part_inside_fraction);
+      check.min_line_inside_fraction =
+          std::min(check.min_line_inside_fraction, line_check.inside_fraction);
+      if (line_check.fibre_part_inside_fraction < options.min_inside_fraction) {
+        report.problems.push_back(muscle.name + ": action line " + line.name + " has " +
+                                  number_text(100 * line_check.fibre_part_inside_fraction, 1) +
+                                  "% of its fibre part inside the muscle (" +
+                                  number_text(100 * line_check.inside_fraction, 1) + "% of its " +
+                                  number_text(line_check.length_mm, 0) + " mm, tendon " +
+                                  number_text(line_check.tendon_mm, 0) + " mm; at least " +
+                                  number_text(100 * options.min_inside_fraction, 0) +
+                                  "% required)");
       }
       report.action_lines.push_back(line_check);
     }

@@ -4,9 +4,12 @@
 //   - every bone and muscle mesh (every level) is a closed 2-manifold,
 //     consistently oriented;
 //   - no muscle enters a bone deeper than `max_penetration_mm` at rest;
-//   - every action line lies at least `min_inside_fraction` inside its own
-//     muscle (the polyline sampled every `sample_step_mm`; inside = winding
-//     number > 1/2);
+//   - the fibre part of every action line lies at least `min_inside_fraction`
+//     inside its own muscle: the inside length (the polyline sampled every
+//     `sample_step_mm`; inside = winding number > 1/2) over the line's length
+//     less the muscle's tendon slack length (muscle surfaces end where the
+//     tendon begins: the iliotibial band of the tensor fasciae latae, the
+//     patellar tendon of the quadriceps);
 //   - the required landmarks exist (kRequiredLandmarks);
 //   - every reference resolves (read_atlas checks that; a failure is
 //     reported as a problem here rather than thrown).
@@ -42,7 +45,11 @@ struct ActionLineCheck {
   std::string muscle;
   std::string line;
   double length_mm = 0.0;
-  double inside_fraction = 0.0;
+  double inside_fraction = 0.0;  // of the whole length
+  double tendon_mm = 0.0;        // the muscle's tendon slack length, at most 3/4 of the path
+  // Inside length over the fibre part (length - tendon), at most 1: what the
+  // check holds against min_inside_fraction.
+  double fibre_part_inside_fraction = 0.0;
 };
 
 struct MuscleCheck {
@@ -50,8 +57,9 @@ struct MuscleCheck {
   double volume_mm3 = 0.0;  // full level
   int faces = 0;            // full level
   double max_penetration_mm = 0.0;
-  std::string deepest_bone;          // the bone it enters most, empty if none
-  double min_inside_fraction = 1.0;  // over its action lines (1 when it has none)
+  std::string deepest_bone;               // the bone it enters most, empty if none
+  double min_inside_fraction = 1.0;       // fibre part, over its action lines (1 when it has none)
+  double min_line_inside_fraction = 1.0;  // whole length, over its action lines
 };
 
 struct AtlasCheckReport {

@@ -1,0 +1,249 @@
+// mmm atlas build|check: the command-line face of core/atlas.
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/commands/commands.h"
+#include "core/atlas/atlas_builder.h"
+#include "core/atlas/atlas_check.h"
+#include "core/atlas/atlas_recipe.h"
+
+namespace mmm::app {
+namespace {
+
+struct BuildArgs {
+  std::string recipe;
+  std::string out;
+  std::string data = MMM_DEFAULT_DATA_DIR;
+  bool json = false;
+};
+
+nlohmann::json build_json(const atlas::AtlasBuildReport& report) {
+  nlohmann::json json;
+  json["seconds"] = report.seconds;
+  nlohmann::json registrations = nlohmann::json::array();
+  for (const atlas::BodyRegistrationReport& r : report.registrations) {
+    nlohmann::json anchors = nlohmann::json::object();
+    for (const auto& [name, residual] : r.anchor_residuals_mm) anchors[name] = residual;
+    registrations.push_back({{"body", r.body},
+                             {"method", r.method},
+                             {"scale", r.scale},
+                             {"surface_rms_mm", r.rms_mm},
+                             {"surface_mean_mm", r.mean_distance_mm},
+                             {"surface_pairs", r.pairs},
+                             {"anchor_residuals_mm", anchors}});
+  }
+  json["registrations"] = registrations;
+  nlohmann::json joints = nlohmann::json::array();
+  for (const atlas::JointBuildReport& j : report.joints) {
+    nlohmann::json rest = nlohmann::json::object();
+    for (const auto& [name, value] : j.rest_values) rest[name] = value;
+    joints.push_back({{"joint", j.name},
+                      {"rest_values", rest},
+                      {"frame_mismatch_mm", j.frame_mismatch_mm},
+                      {"frame_mismatch_deg", j.frame_mismatch_deg}});
+  }
+  json["joints"] = joints;
+  nlohmann::json muscles = nlohmann::json::array();
+  for (const atlas::MuscleBuildReport& m : report.muscles) {
+    muscles.push_back({{"name", m.name},
+                       {"faces", m.faces},
+                       {"volume_mm3", m.volume_mm3},
+                       {"max_penetration_before_mm", m.max_penetration_before_mm},
+                       {"vertices_moved", m.vertices_moved},
+                       {"volume_change_percent", m.volume_change_percent}});
+  }
+  json["muscles"] = muscles;
+  nlohmann::json lines = nlohmann::json::array();
+  for (const atlas::ActionLineBuildReport& l : report.action_lines) {
+    lines.push_back({{"muscle", l.muscle},
+                     {"line", l.line},
+                     {"inside_before", l.inside_before},
+                     {"inside_after", l.inside_after},
+                     {"points_added", l.points_added},
+                     {"origin_on_contact", l.origin_on_contact},
+                     {"insertion_on_contact", l.insertion_on_contact}});
+  }
+  json["action_lines"] = lines;
+  json["notes"] = report.notes;
+  return json;
+}
+
+void print_build(const atlas::AtlasBuildReport& report) {
+  std::cout << std::fixed << std::setprecision(2);
+  std::cout << "registration of the OpenSim bodies (surface RMS, anchors in mm):\n";
+  for (const atlas::BodyRegistrationReport& r : report.registrations) {
+    std::cout << "  " << std::left << std::setw(10) << r.body << std::setw(20) << r.method
+              << " scale " << std::setprecision(3) << r.scale << std::setprecision(2) << "  rms "
+              << r.rms_mm << " mm (" << r.pairs << " pairs)";
+    for (const auto& [name, residual] : r.anchor_residuals_mm) {
+      std::cout << "  " << name << " " << residual;
+    }
+    std::cout << '\n';
+  }
+  std::cout << "joints at rest (mismatch of the mapped frames):\n";
+  for (const atlas::JointBuildReport& j : report.joints) {
+    std::cout << "  " << std::left << std::setw(12) << j.name << j.frame_mismatch_mm << " mm "
+              << j.frame_mismatch_deg << " deg:";
+    for (const auto& [name, value] : j.rest_values) std::cout << " " << name << "=" << value;
+    std::cout << '\n';
+  }
+  std::cout << "muscles cleaned of bone penetration:\n";
+  for (const atlas::MuscleBuildReport& m : report.muscles) {
+    std::cout << "  " << std::left << std::setw(30) << m.name << std::right << " deepest before "
+              << std::setw(6) << m.max_penetration_before_mm << " mm, " << std::setw(5)
+              << m.vertices_moved << " vertices moved, volume " << std::showpos
+              << m.volume_change_percent << std::noshowpos << "%\n";
+  }
+  std::cout << "action lines fitted into their muscles (inside fraction before -> after):\n";
+  for (const atlas::ActionLineBuildReport& l : report.action_lines) {
+    std::cout << "  " << std::left << std::setw(30) << l.muscle << std::setw(14) << l.line
+              << std::right << std::setprecision(1) << std::setw(6) << 100 * l.inside_before
+              << "% -> " << std::setw(5) << 100 * l.inside_after << "%, " << l.points_added
+              << " point(s) added" << (l.origin_on_contact ? ", origin on contact" : "")
+              << (l.insertion_on_contact ? ", insertion on contact" : "") << '\n';
+  }
+  std::cout << std::setprecision(2);
+  for (const std::string& note : report.notes) std::cout << "note: " << note << '\n';
+  std::cout << "built in " << report.seconds << " s\n";
+}
+
+void run_build(const BuildArgs& args) {
+  const atlas::AtlasRecipe recipe = atlas::read_atlas_recipe(args.recipe);
+  atlas::AtlasBuildOptions options;
+  options.data_dir = args.data;
+  const atlas::AtlasBuildReport report = atlas::build_atlas(recipe, options, args.out);
+  const nlohmann::json json = build_json(report);
+  {
+    std::ofstream file(std::filesystem::path(args.out) / "build_report.json");
+    file << json.dump(2) << '\n';
+  }
+  if (args.json) {
+    std::cout << json.dump(2) << '\n';
+  } else {
+    print_build(report);
+    std::cout << "atlas written to " << args.out << " (check it with: mmm atlas check " << args.out
+              << ")\n";
+  }
+}
+
+struct CheckArgs {
+  std::string dir;
+  bool json = false;
+  double max_penetration_mm = 1.0;
+  double min_inside = 0.8;
+};
+
+nlohmann::json check_json(const atlas::AtlasCheckReport& report) {
+  nlohmann::json json;
+  json["passed"] = report.passed();
+  json["problems"] = report.problems;
+  nlohmann::json muscles = nlohmann::json::array();
+  for (const atlas::MuscleCheck& m : report.muscles) {
+    muscles.push_back({{"name", m.name},
+                       {"volume_mm3", m.volume_mm3},
+                       {"faces", m.faces},
+                       {"max_penetration_mm", m.max_penetration_mm},
+                       {"deepest_bone", m.deepest_bone},
+                       {"min_fibre_part_inside_fraction", m.min_inside_fraction},
+                       {"min_action_line_inside_fraction", m.min_line_inside_fraction}});
+  }
+  json["muscles"] = muscles;
+  nlohmann::json lines = nlohmann::json::array();
+  for (const atlas::ActionLineCheck& l : report.action_lines) {
+    lines.push_back({{"muscle", l.muscle},
+                     {"line", l.line},
+                     {"length_mm", l.length_mm},
+                     {"inside_fraction", l.inside_fraction},
+                     {"tendon_mm", l.tendon_mm},
+                     {"fibre_part_inside_fraction", l.fibre_part_inside_fraction}});
+  }
+  json["action_lines"] = lines;
+  nlohmann::json meshes = nlohmann::json::array();
+  for (const atlas::MeshHealth& h : report.meshes) {
+    meshes.push_back({{"element", h.element},
+                      {"level", h.level},
+                      {"faces", h.faces},
+                      {"closed", h.closed},
+                      {"manifold", h.manifold},
+                      {"outward", h.oriented},
+                      {"volume_mm3", h.volume_mm3}});
+  }
+  json["meshes"] = meshes;
+  return json;
+}
+
+void print_check(const atlas::AtlasCheckReport& report) {
+  std::cout << std::left << std::setw(34) << "muscle" << std::right << std::setw(14)
+            << "volume mm^3" << std::setw(9) << "faces" << std::setw(16) << "penetration mm"
+            << std::setw(13) << "line inside" << std::setw(13) << "fibres in" << '\n';
+  std::cout << std::fixed;
+  for (const atlas::MuscleCheck& m : report.muscles) {
+    std::cout << std::left << std::setw(34) << m.name << std::right << std::setw(14)
+              << std::setprecision(0) << m.volume_mm3 << std::setw(9) << m.faces << std::setw(16)
+              << std::setprecision(2) << m.max_penetration_mm << std::setw(12)
+              << std::setprecision(1) << 100 * m.min_line_inside_fraction << "%" << std::setw(12)
+              << 100 * m.min_inside_fraction << "%\n";
+  }
+  std::cout << report.meshes.size() << " meshes checked\n";
+  for (const std::string& problem : report.problems) std::cerr << "problem: " << problem << '\n';
+  std::cout << (report.passed() ? "atlas check passed\n" : "atlas check FAILED\n");
+}
+
+void run_check(const CheckArgs& args) {
+  atlas::AtlasCheckOptions options;
+  options.max_penetration_mm = args.max_penetration_mm;
+  options.min_inside_fraction = args.min_inside;
+  const atlas::AtlasCheckReport report = atlas::check_atlas(args.dir, options);
+  if (args.json) {
+    std::cout << check_json(report).dump(2) << '\n';
+  } else {
+    print_check(report);
+  }
+  if (!report.passed()) set_exit_code(kExitFailed);
+}
+
+}  // namespace
+
+void register_atlas_commands(CLI::App& app) {
+  auto* atlas = app.add_subcommand("atlas", "Build, check and look at musculoskeletal atlases");
+  atlas->require_subcommand(1);
+
+  auto build_args = std::make_shared<BuildArgs>();
+  auto* build = atlas->add_subcommand(
+      "build",
+      "Build an atlas folder from a recipe (schemas/recipes/vhf_right_leg.yaml is the "
+      "default atlas) and the real data");
+  build->add_option("RECIPE", build_args->recipe, "Recipe file (YAML)")->required();
+  build->add_option("-o,--out", build_args->out, "Atlas folder to write")->required();
+  build->add_option("--data", build_args->data,
+                    "Folder the recipe's data paths are relative to (default: the shared data "
+                    "this mmm was built with)");
+  build->add_flag("--json", build_args->json, "Print the build report as JSON");
+  build->callback([build_args] { run_build(*build_args); });
+
+  auto check_args = std::make_shared<CheckArgs>();
+  auto* check = atlas->add_subcommand(
+      "check",
+      "Check an atlas: closed meshes, no muscle in bone, action lines inside muscles, "
+      "required landmarks; prints each muscle's volume and triangles");
+  check->add_option("DIR", check_args->dir, "Atlas folder (holding atlas.yaml)")->required();
+  check->add_flag("--json", check_args->json, "Print JSON instead of a table");
+  check
+      ->add_option("--max-penetration", check_args->max_penetration_mm,
+                   "Deepest muscle vertex allowed inside a bone (mm)")
+      ->check(CLI::Range(0.0, 100.0));
+  check
+      ->add_option("--min-inside", check_args->min_inside,
+                   "Least fraction of the fibre part (length less tendon) of each action line "
+                   "inside its muscle")
+      ->check(CLI::Range(0.0, 1.0));
+  check->callback([check_args] { run_check(*check_args); });
+}
+
+}  // namespace mmm::app

@@ -1,0 +1,225 @@
+#include "core/atlas/action_line_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "core/atlas/atlas_check.h"
+#include "core/errors.h"
+
+namespace mmm::atlas {
+namespace {
+
+struct Geometry {
+  const mesh::AabbTree& muscle;
+  const std::function<bool(const Eigen::Vector3d&)>& inside;
+};
+
+std::vector<Eigen::Vector3d> positions(const ActionLine& line) {
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(line.points.size());
+  for (const PathPoint& point : line.points) points.push_back(point.position);
+  return points;
+}
+
+double distance_to_polyline(const Eigen::Vector3d& q, const std::vector<Eigen::Vector3d>& line) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+    const Eigen::Vector3d d = line[i + 1] - line[i];
+    const double length_sq = d.squaredNorm();
+    const double t = length_sq > 0 ? std::clamp((q - line[i]).dot(d) / length_sq, 0.0, 1.0) : 0.0;
+    best = std::min(best, (line[i] + t * d - q).norm());
+  }
+  if (line.size() == 1) best = (line.front() - q).norm();
+  return best;
+}
+
+// The centre of the bundle's cross-section in the slab across `direction`
+// at `at`: the point of the section deepest inside the muscle among its
+// centroid and the midpoints of pairs of its vertices (a C-shaped section,
+// as of the vastus intermedius around the femur, has its centroid outside).
+std::optional<Eigen::Vector3d> section_centre(const std::vector<Eigen::Vector3d>& bundle,
+                                              const Eigen::Vector3d& at,
+                                              const Eigen::Vector3d& direction,
+                                              const Geometry& geometry,
+                                              const ActionLineFitOptions& options) {
+  std::vector<Eigen::Vector3d> section;
+  const double radius_sq = options.section_radius_mm * options.section_radius_mm;
+  for (const Eigen::Vector3d& v : bundle) {
+    if (std::abs((v - at).dot(direction)) > options.slab_mm) continue;
+    if ((v - at).squaredNorm() > radius_sq) continue;
+    section.push_back(v);
+  }
+  if (section.size() < 6) return std::nullopt;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& v : section) centroid += v;
+  centroid /= static_cast<double>(section.size());
+  std::vector<Eigen::Vector3d> candidates{centroid};
+  const std::size_t n = section.size();
+  const std::size_t stride = std::max<std::size_t>(1, n / 24);
+  for (std::size_t i = 0; i < n; i += stride) {
+    for (std::size_t j = i + stride; j < n; j += stride) {
+      candidates.push_back(0.5 * (section[i] + section[j]));
+    }
+  }
+  double best_depth = -1.0;
+  Eigen::Vector3d best = centroid;
+  for (const Eigen::Vector3d& candidate : candidates) {
+    if (!geometry.inside(candidate)) continue;
+    const double depth = std::sqrt(geometry.muscle.closest_point(candidate).squared_distance);
+    if (depth > best_depth) {
+      best_depth = depth;
+      best = candidate;
+    }
+  }
+  return best;
+}
+
+// Where the bundle touches `bone` near `end`: the bone point nearest the
+// centroid of the bundle vertices within contact distance of the bone, or,
+// when none is that close, nearest the bundle vertex closest to the bone.
+std::optional<Eigen::Vector3d> contact_point(const std::vector<Eigen::Vector3d>& bundle,
+                                             const mesh::AabbTree& bone, const Eigen::Vector3d& end,
+                                             const ActionLineFitOptions& options) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  double nearest = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d nearest_vertex = end;
+  const double search_sq = options.search_radius_mm * options.search_radius_mm;
+  for (const Eigen::Vector3d& v : bundle) {
+    if ((v - end).squaredNorm() > search_sq) continue;
+    const double distance = bone.closest_point(v).squared_distance;
+    if (distance < nearest) {
+      nearest = distance;
+      nearest_vertex = v;
+    }
+    if (distance > options.contact_mm * options.contact_mm) continue;
+    sum += v;
+    ++count;
+  }
+  if (count >= 3) return bone.closest_point(sum / count).point;
+  if (std::isfinite(nearest)) return bone.closest_point(nearest_vertex).point;
+  return std::nullopt;
+}
+
+Eigen::Vector3d direction_at(const std::vector<Eigen::Vector3d>& line, std::size_t i) {
+  const Eigen::Vector3d before = line[i > 0 ? i - 1 : 0];
+  const Eigen::Vector3d after = line[std::min(i + 1, line.size() - 1)];
+  const Eigen::Vector3d d = after - before;
+  return d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::UnitZ();
+}
+
+}  // namespace
+
+std::vector<ActionLineFitReport> fit_action_lines(
+    Muscle& muscle, const mesh::IndexedMesh& surface,
+    const std::function<bool(const Eigen::Vector3d&)>& inside,
+    const std::map<std::string, const mesh::AabbTree*>& bones,
+    const ActionLineFitOptions& options) {
+  const auto bone_tree = [&](const std::string& name) -> const mesh::AabbTree& {
+    const auto it = bones.find(name);
+    if (it == bones.end()) {
+      throw InvalidInputError("fit_action_lines: muscle " + muscle.name + ": no bone '" + name +
+                              "'");
+    }
+    return *it->second;
+  };
+  const mesh::AabbTree muscle_tree(surface);
+  const Geometry geometry{muscle_tree, inside};
+  // 1. bundles
+  std::vector<std::vector<Eigen::Vector3d>> bundles(muscle.action_lines.size());
+  std::vector<std::vector<Eigen::Vector3d>> lines;
+  for (const ActionLine& line : muscle.action_lines) lines.push_back(positions(line));
+  for (Eigen::Index v = 0; v < surface.V.rows(); ++v) {
+    const Eigen::Vector3d q = surface.V.row(v).transpose();
+    std::size_t best = 0;
+    double best_distance = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < lines.size(); ++k) {
+      const double d = distance_to_polyline(q, lines[k]);
+      if (d < best_distance) {
+        best_distance = d;
+        best = k;
+      }
+    }
+    if (!lines.empty()) bundles[best].push_back(q);
+  }
+
+  std::vector<ActionLineFitReport> reports;
+  for (std::size_t k = 0; k < muscle.action_lines.size(); ++k) {
+    ActionLine& line = muscle.action_lines[k];
+    const std::vector<Eigen::Vector3d>& bundle = bundles[k];
+    ActionLineFitReport report;
+    report.line = line.name;
+    report.inside_before = inside_fraction(positions(line), options.sample_step_mm, inside);
+    if (line.points.size() < 2 || bundle.empty()) {
+      report.inside_after = report.inside_before;
+      reports.push_back(report);
+      continue;
+    }
+    // 2. ends onto the contact
+    PathPoint& origin = line.points.front();
+    PathPoint& insertion = line.points.back();
+    if (origin.kind != PathPointKind::kMoving) {
+      if (const auto contact =
+              contact_point(bundle, bone_tree(origin.bone), origin.position, options)) {
+        origin.position = *contact;
+        report.origin_on_contact = true;
+      }
+    }
+    if (insertion.kind != PathPointKind::kMoving) {
+      if (const auto contact =
+              contact_point(bundle, bone_tree(insertion.bone), insertion.position, options)) {
+        insertion.position = *contact;
+        report.insertion_on_contact = true;
+      }
+    }
+    // 3. via points onto their section centres
+    std::vector<Eigen::Vector3d> current = positions(line);
+    for (std::size_t i = 1; i + 1 < line.points.size(); ++i) {
+      if (line.points[i].kind == PathPointKind::kMoving) continue;
+      if (const auto centre =
+              section_centre(bundle, current[i], direction_at(current, i), geometry, options)) {
+        line.points[i].position = *centre;
+        current[i] = *centre;
+      }
+    }
+    // 4. split segments that leave the muscle
+    for (int level = 0; level < options.max_splits; ++level) {
+      std::vector<PathPoint> refined{line.points.front()};
+      bool split = false;
+      for (std::size_t i = 0; i + 1 < line.points.size(); ++i) {
+        const PathPoint& a = line.points[i];
+        const PathPoint& b = line.points[i + 1];
+        const double length = (b.position - a.position).norm();
+        if (length >= options.min_segment_mm &&
+            inside_fraction({a.position, b.position}, options.sample_step_mm, inside) <
+                options.good_fraction) {
+          const Eigen::Vector3d middle = 0.5 * (a.position + b.position);
+          if (const auto centre = section_centre(
+                  bundle, middle, (b.position - a.position).normalized(), geometry, options)) {
+            PathPoint added;
+            added.name = line.name + "-fit" + std::to_string(report.points_added + 1);
+            const double to_a =
+                std::sqrt(bone_tree(a.bone).closest_point(*centre).squared_distance);
+            const double to_b =
+                std::sqrt(bone_tree(b.bone).closest_point(*centre).squared_distance);
+            added.bone = to_a <= to_b ? a.bone : b.bone;
+            added.position = *centre;
+            refined.push_back(std::move(added));
+            ++report.points_added;
+            split = true;
+          }
+        }
+        refined.push_back(b);
+      }
+      line.points = std::move(refined);
+      if (!split) break;
+    }
+    report.inside_after = inside_fraction(positions(line), options.sample_step_mm, inside);
+    reports.push_back(report);
+  }
+  return reports;
+}
+
+}  // namespace mmm::atlas

@@ -1,0 +1,64 @@
+#pragma once
+// Fitting generic action lines to a subject's muscle. The lines of a generic
+// model (gait2392), mapped by bone registrations, keep their structure
+// (points, kinds, bones) but rarely run through the subject's own muscle
+// surface. A muscle's action line is the skeleton its surface is wrapped
+// around (VPHOP D10.2, 3.4.2), so it has to lie inside:
+//
+//   1. the muscle's vertices are shared among its lines (each vertex goes
+//      to the nearest line): one bundle per line;
+//   2. each end (origin, insertion) moves onto the bone where its bundle
+//      touches it: the bone point nearest the centroid of the bundle
+//      vertices within `contact_mm` of the bone and `search_radius_mm` of
+//      the end, or, when the bundle does not touch the bone there, nearest
+//      the bundle's closest approach to it (a tendon the surface leaves out);
+//   3. each via point (fixed or conditional) moves to the centre of its
+//      bundle's cross-section in the slab of half-width `slab_mm` across the
+//      line at that point: the section's point deepest inside the muscle
+//      among its centroid and midpoints of its vertices (moving points,
+//      whose place is a function of a coordinate, stay);
+//   4. a segment that still leaves the muscle is split at its middle by a
+//      new fixed via point at the cross-section centre there, attached to
+//      whichever of the segment's bones is nearer; recursively, up to
+//      `max_splits` levels.
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/atlas/atlas.h"
+#include "core/mesh/aabb_tree.h"
+
+namespace mmm::atlas {
+
+struct ActionLineFitOptions {
+  double contact_mm = 3.0;
+  double search_radius_mm = 60.0;
+  double slab_mm = 3.0;
+  double section_radius_mm = 60.0;  // cross-section vertices farther than this are ignored
+  int max_splits = 4;
+  double sample_step_mm = 1.0;  // for the inside fraction of a segment
+  double good_fraction = 0.95;  // segments at least this much inside are not split
+  double min_segment_mm = 8.0;  // shorter segments are not split
+};
+
+struct ActionLineFitReport {
+  std::string line;
+  double inside_before = 0.0;  // fraction of the length inside the muscle
+  double inside_after = 0.0;
+  int points_added = 0;
+  bool origin_on_contact = false;
+  bool insertion_on_contact = false;
+};
+
+// Fits every action line of `muscle` (in place). `surface` is the muscle's
+// surface, `inside` its inside test, `bones` the atlas bones' trees by name
+// (every bone the lines name must be there).
+std::vector<ActionLineFitReport> fit_action_lines(
+    Muscle& muscle, const mesh::IndexedMesh& surface,
+    const std::function<bool(const Eigen::Vector3d&)>& inside,
+    const std::map<std::string, const mesh::AabbTree*>& bones,
+    const ActionLineFitOptions& options = {});
+
+}  // namespace mmm::atlas
