@@ -16,8 +16,11 @@ void register_mesh_commands(CLI::App& app);
 // mmm validate|graph|nodes (the registry must outlive the parse)
 void register_workflow_commands(CLI::App& app, const workflow::NodeRegistry& registry);
 
-// mmm atlas check (and, as they arrive, build and show)
+// mmm atlas build|check|show
 void register_atlas_commands(CLI::App& app);
+
+// mmm patient synth
+void register_patient_commands(CLI::App& app);
 
 // mmm study create|set, mmm run, mmm status, mmm explain
 void register_study_commands(CLI::App& app, const workflow::NodeRegistry& registry);

@@ -1,0 +1,183 @@
+#include "core/atlas/synthetic_patient.h"
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "core/atlas/atlas_io.h"
+#include "core/errors.h"
+#include "core/image/png.h"
+#include "core/mesh/aabb_tree.h"
+#include "core/mesh/io/mesh_io.h"
+#include "core/mesh/mass_properties.h"
+
+namespace mmm::atlas {
+namespace {
+
+// Writes every level of every element, deformed, under `dir`; returns the
+// full-resolution patient meshes (bones, muscles) by name.
+struct PatientMeshes {
+  std::map<std::string, mesh::IndexedMesh> bones;    // full
+  std::map<std::string, mesh::IndexedMesh> muscles;  // `muscle_level`
+};
+
+PatientMeshes write_patient_meshes(const Atlas& atlas, const std::filesystem::path& atlas_dir,
+                                   const PatientDeformation& deformation,
+                                   const std::filesystem::path& dir,
+                                   const SyntheticPatientOptions& options) {
+  PatientMeshes meshes;
+  // Muscles blend the bone maps by distance to the bones: the coarsest bone
+  // level is plenty for distances on the scale of the blend radius.
+  std::map<std::string, mesh::IndexedMesh> blend_bones;
+  for (const Bone& bone : atlas.bones) {
+    for (const MeshLevel& level : bone.meshes) {
+      const mesh::IndexedMesh deformed =
+          deform_bone_mesh(deformation, bone.name, load_mesh(atlas_dir, bone.meshes, level.level));
+      std::filesystem::create_directories((dir / level.file).parent_path());
+      mesh::write_mesh(deformed, dir / level.file);
+      if (level.level == "full") meshes.bones[bone.name] = deformed;
+    }
+    blend_bones[bone.name] = load_mesh(atlas_dir, bone.meshes, bone.meshes.back().level);
+  }
+  for (const Muscle& muscle : atlas.muscles) {
+    for (const MeshLevel& level : muscle.meshes) {
+      const mesh::IndexedMesh deformed = deform_muscle_mesh(
+          deformation, blend_bones, load_mesh(atlas_dir, muscle.meshes, level.level),
+          options.deformation.blend_radius_mm);
+      std::filesystem::create_directories((dir / level.file).parent_path());
+      mesh::write_mesh(deformed, dir / level.file);
+      if (level.level == options.muscle_level ||
+          (level.level == "full" && !meshes.muscles.contains(muscle.name))) {
+        meshes.muscles[muscle.name] = deformed;
+      }
+    }
+  }
+  return meshes;
+}
+
+// 8-bit picture of a 16-bit radiograph: the 0.5th-99.5th percentile window.
+image::GrayImage8 preview(const image::GrayImage16& radiograph) {
+  std::vector<std::uint16_t> sorted = radiograph.pixels;
+  std::ranges::sort(sorted);
+  const double low = sorted[sorted.size() / 200];
+  const double high = std::max(low + 1.0, static_cast<double>(sorted[sorted.size() * 199 / 200]));
+  image::GrayImage8 picture(radiograph.width, radiograph.height);
+  for (std::size_t i = 0; i < radiograph.pixels.size(); ++i) {
+    const double t = (radiograph.pixels[i] - low) / (high - low);
+    picture.pixels[i] = static_cast<std::uint8_t>(std::clamp(t, 0.0, 1.0) * 255.0 + 0.5);
+  }
+  return picture;
+}
+
+nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+SyntheticPatientReport make_synthetic_patient(const std::filesystem::path& atlas_dir,
+                                              const std::filesystem::path& out_dir,
+                                              const SyntheticPatientOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  if (!(options.detector_pixel_pitch_mm > 0) || !(options.field_margin_mm >= 0) ||
+      !(options.mu_bone_per_mm >= 0) || !(options.mu_soft_per_mm >= 0)) {
+    throw InvalidInputError("patient synth: pixel pitch must be > 0, margin and attenuations >= 0");
+  }
+  const Atlas atlas = read_atlas(atlas_dir);
+  const PatientDeformation deformation = make_patient_deformation(atlas, options.deformation);
+  Atlas patient = deform_atlas(atlas, deformation);
+  patient.name = atlas.name + "_patient_" + std::to_string(options.deformation.seed);
+  patient.provenance.push_back("synthetic patient of atlas " + atlas.name + ", seed " +
+                               std::to_string(options.deformation.seed));
+
+  const std::filesystem::path partial = out_dir.string() + ".partial";
+  std::filesystem::remove_all(partial);
+  std::filesystem::create_directories(partial / "radiographs");
+  const PatientMeshes meshes =
+      write_patient_meshes(atlas, atlas_dir, deformation, partial / "atlas", options);
+  write_atlas_manifest(patient, partial / "atlas");
+
+  // Views centred on the bones, the field covering them with a margin.
+  Eigen::AlignedBox3d box;
+  for (const auto& [name, surface] : meshes.bones) box.extend(mesh::bounding_box(surface));
+  image::BiplanarOptions geometry;
+  geometry.isocentre_mm = box.center();
+  geometry.source_to_isocentre_mm = options.source_to_isocentre_mm;
+  geometry.source_to_detector_mm = options.source_to_detector_mm;
+  geometry.detector_pixel_pitch_mm = options.detector_pixel_pitch_mm;
+  const Eigen::Vector3d size = box.sizes();
+  geometry.field_width_mm = std::max(size.x(), size.y()) + 2 * options.field_margin_mm;
+  geometry.field_height_mm = size.z() + 2 * options.field_margin_mm;
+  const std::array<image::RadiographView, 2> views = image::make_biplanar_views(geometry);
+
+  std::vector<std::unique_ptr<mesh::AabbTree>> trees;
+  std::vector<image::AttenuatingMesh> materials;
+  for (const auto& [name, surface] : meshes.bones) {
+    trees.push_back(std::make_unique<mesh::AabbTree>(surface));
+    materials.push_back({trees.back().get(), options.mu_bone_per_mm});
+  }
+  for (const auto& [name, surface] : meshes.muscles) {
+    trees.push_back(std::make_unique<mesh::AabbTree>(surface));
+    materials.push_back({trees.back().get(), options.mu_soft_per_mm});
+  }
+  std::vector<image::RadiographFile> files;
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    const image::FloatImage integrals =
+        image::render_drr(views[k], materials, image::DrrOptions{options.threads});
+    image::RadiographOptions radiograph = options.radiograph;
+    radiograph.seed = options.radiograph.seed * 1000003U + options.deformation.seed * 2U + k;
+    const image::GrayImage16 picture = image::to_radiograph(integrals, radiograph);
+    const std::string file = views[k].name + ".png";
+    image::write_png(picture, partial / "radiographs" / file);
+    image::write_png(preview(picture), partial / "radiographs" / (views[k].name + "_preview.png"));
+    files.push_back({views[k], file});
+  }
+  image::write_view_sidecar(partial / "radiographs" / "views.json", files);
+
+  nlohmann::json truth;
+  truth["format"] = "mmm-synthetic-patient";
+  truth["version"] = 1;
+  truth["atlas"] = atlas.name;
+  truth["seed"] = deformation.factors.seed;
+  truth["height_mm"] = deformation.factors.height_mm;
+  truth["stature_scale"] = deformation.factors.stature_scale;
+  truth["pelvis_width"] = deformation.factors.pelvis_width;
+  truth["segment_length"] = deformation.factors.length;
+  truth["segment_width"] = deformation.factors.width;
+  nlohmann::json landmarks = nlohmann::json::object();
+  for (const Landmark& landmark : patient.landmarks) {
+    nlohmann::json entry;
+    entry["bone"] = landmark.bone;
+    entry["position_mm"] = vector_json(landmark.position);
+    for (const image::RadiographView& view : views) {
+      const Eigen::Vector2d pixel = image::project(view, landmark.position);
+      entry["pixels"][view.name] = {pixel.x(), pixel.y()};
+    }
+    landmarks[landmark.name] = entry;
+  }
+  truth["landmarks"] = landmarks;
+  {
+    std::ofstream out(partial / "ground_truth.json");
+    out << truth.dump(2) << '\n';
+    if (!out) throw IoError(partial / "ground_truth.json", "cannot write");
+  }
+
+  const std::filesystem::path previous = out_dir.string() + ".previous";
+  std::filesystem::remove_all(previous);
+  if (std::filesystem::exists(out_dir)) std::filesystem::rename(out_dir, previous);
+  std::filesystem::rename(partial, out_dir);
+  std::filesystem::remove_all(previous);
+
+  SyntheticPatientReport report;
+  report.factors = deformation.factors;
+  report.frontal_width = views[0].width;
+  report.frontal_height = views[0].height;
+  report.pixel_spacing_mm = views[0].pixel_spacing_mm;
+  report.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return report;
+}
+
+}  // namespace mmm::atlas
