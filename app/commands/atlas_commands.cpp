@@ -1,5 +1,6 @@
 // mmm atlas build|check: the command-line face of core/atlas.
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -11,7 +12,10 @@
 #include "app/commands/commands.h"
 #include "core/atlas/atlas_builder.h"
 #include "core/atlas/atlas_check.h"
+#include "core/atlas/atlas_io.h"
 #include "core/atlas/atlas_recipe.h"
+#include "core/image/mesh_render.h"
+#include "core/image/png.h"
 
 namespace mmm::app {
 namespace {
@@ -132,6 +136,62 @@ void run_build(const BuildArgs& args) {
   }
 }
 
+struct ShowArgs {
+  std::string dir;
+  std::string png;
+  std::string level = "lod1";
+  int width = 500;
+};
+
+// Front and side views with the muscles, then the same without them (the
+// skeleton), side by side.
+void run_show(const ShowArgs& args) {
+  const atlas::Atlas model = atlas::read_atlas(args.dir);
+  std::vector<mesh::IndexedMesh> surfaces;
+  surfaces.reserve(model.bones.size() + model.muscles.size());
+  std::vector<image::RenderItem> bones;
+  std::vector<image::RenderItem> everything;
+  const auto level_of = [&](const std::vector<atlas::MeshLevel>& levels) {
+    const bool has = std::ranges::any_of(
+        levels, [&](const atlas::MeshLevel& level) { return level.level == args.level; });
+    return has ? args.level : std::string("full");
+  };
+  for (const atlas::Bone& bone : model.bones) {
+    surfaces.push_back(atlas::load_mesh(args.dir, bone.meshes, level_of(bone.meshes)));
+  }
+  for (const atlas::Muscle& muscle : model.muscles) {
+    surfaces.push_back(atlas::load_mesh(args.dir, muscle.meshes, level_of(muscle.meshes)));
+  }
+  for (std::size_t i = 0; i < model.bones.size(); ++i) {
+    bones.push_back({&surfaces[i], {235, 226, 200}});
+  }
+  everything = bones;
+  for (std::size_t i = 0; i < model.muscles.size(); ++i) {
+    // Muscles in reds that differ slightly from one to the next.
+    const auto shade = static_cast<std::uint8_t>(40 + (i * 37) % 70);
+    everything.push_back({&surfaces[model.bones.size() + i],
+                          {static_cast<std::uint8_t>(190 + (i * 23) % 50), shade, shade}});
+  }
+  // One scale for every panel: the widest extent (x or y) fills a panel.
+  Eigen::AlignedBox3d box;
+  for (const mesh::IndexedMesh& surface : surfaces) {
+    for (Eigen::Index v = 0; v < surface.V.rows(); ++v) {
+      box.extend(Eigen::Vector3d(surface.V.row(v).transpose()));
+    }
+  }
+  image::RenderOptions front;
+  front.pixels_per_mm = (args.width - 2.0 * front.margin_px) /
+                        std::max(1.0, std::max(box.sizes().x(), box.sizes().y()));
+  image::RenderOptions side = front;
+  side.view_direction = Eigen::Vector3d(-1, 0, 0);
+  const std::vector<image::RgbImage8> panels = {
+      image::render_meshes(everything, front), image::render_meshes(everything, side),
+      image::render_meshes(bones, front), image::render_meshes(bones, side)};
+  image::write_png(image::side_by_side(panels), args.png);
+  std::cout << "wrote " << args.png << ": front and side views with muscles, then bones only ("
+            << model.bones.size() << " bones, " << model.muscles.size() << " muscles)\n";
+}
+
 struct CheckArgs {
   std::string dir;
   bool json = false;
@@ -226,6 +286,16 @@ void register_atlas_commands(CLI::App& app) {
                     "this mmm was built with)");
   build->add_flag("--json", build_args->json, "Print the build report as JSON");
   build->callback([build_args] { run_build(*build_args); });
+
+  auto show_args = std::make_shared<ShowArgs>();
+  auto* show = atlas->add_subcommand(
+      "show", "Picture of an atlas: front and side views with muscles, then bones only (PNG)");
+  show->add_option("DIR", show_args->dir, "Atlas folder")->required();
+  show->add_option("--png", show_args->png, "PNG file to write")->required();
+  show->add_option("--level", show_args->level, "Mesh level to draw (full, lod1, ...)");
+  show->add_option("--width", show_args->width, "Width of each panel (pixels)")
+      ->check(CLI::Range(100, 4000));
+  show->callback([show_args] { run_show(*show_args); });
 
   auto check_args = std::make_shared<CheckArgs>();
   auto* check = atlas->add_subcommand(

@@ -10,6 +10,7 @@
 
 #include "core/atlas/atlas_io.h"
 #include "core/errors.h"
+#include "core/image/mesh_render.h"
 #include "core/image/png.h"
 #include "core/mesh/aabb_tree.h"
 #include "core/mesh/io/mesh_io.h"
@@ -73,6 +74,20 @@ image::GrayImage8 preview(const image::GrayImage16& radiograph) {
   return picture;
 }
 
+// A 2x2 box-filtered copy as RGB, for the side-by-side picture of the pair.
+image::RgbImage8 half_size_rgb(const image::GrayImage8& picture) {
+  image::RgbImage8 half(picture.width / 2, picture.height / 2);
+  for (int y = 0; y < half.height; ++y) {
+    for (int x = 0; x < half.width; ++x) {
+      const int sum = picture.at(2 * x, 2 * y) + picture.at(2 * x + 1, 2 * y) +
+                      picture.at(2 * x, 2 * y + 1) + picture.at(2 * x + 1, 2 * y + 1);
+      const auto grey = static_cast<std::uint8_t>((sum + 2) / 4);
+      for (int c = 0; c < 3; ++c) half.at(x, y, c) = grey;
+    }
+  }
+  return half;
+}
+
 nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
@@ -123,6 +138,7 @@ SyntheticPatientReport make_synthetic_patient(const std::filesystem::path& atlas
     materials.push_back({trees.back().get(), options.mu_soft_per_mm});
   }
   std::vector<image::RadiographFile> files;
+  std::vector<image::RgbImage8> halves;
   for (std::size_t k = 0; k < views.size(); ++k) {
     const image::FloatImage integrals =
         image::render_drr(views[k], materials, image::DrrOptions{options.threads});
@@ -131,10 +147,14 @@ SyntheticPatientReport make_synthetic_patient(const std::filesystem::path& atlas
     const image::GrayImage16 picture = image::to_radiograph(integrals, radiograph);
     const std::string file = views[k].name + ".png";
     image::write_png(picture, partial / "radiographs" / file);
-    image::write_png(preview(picture), partial / "radiographs" / (views[k].name + "_preview.png"));
+    const image::GrayImage8 windowed = preview(picture);
+    image::write_png(windowed, partial / "radiographs" / (views[k].name + "_preview.png"));
+    halves.push_back(half_size_rgb(windowed));
     files.push_back({views[k], file});
   }
   image::write_view_sidecar(partial / "radiographs" / "views.json", files);
+  image::write_png(image::side_by_side(halves, {10, {0, 0, 0}}),
+                   partial / "radiographs" / "pair_preview.png");
 
   nlohmann::json truth;
   truth["format"] = "mmm-synthetic-patient";

@@ -13,7 +13,8 @@
 //                           at mu_bone, muscles at mu_soft, detector noise
 //   radiographs/views.json  the calibration sidecar (projection.h: 3x4 matrices,
 //                           pixel spacing, source)
-//   radiographs/*_preview.png  8-bit, windowed, for people to look at
+//   radiographs/*_preview.png  8-bit, windowed, for people to look at;
+//                           pair_preview.png both side by side at half size
 
 #include <filesystem>
 #include <string>
