@@ -386,9 +386,13 @@ Eigen::Vector3d triangulate_linear(std::span<const RadiographView> views,
     directions[i] = backproject(views[i], pixels[i]).direction;
   }
   double widest = 0;
+  double baseline = 0;
+  double reach = 0;
   for (std::size_t i = 0; i < directions.size(); ++i) {
+    reach = std::max(reach, views[i].source_mm.norm());
     for (std::size_t j = i + 1; j < directions.size(); ++j) {
       widest = std::max(widest, directions[i].cross(directions[j]).norm());
+      baseline = std::max(baseline, (views[i].source_mm - views[j].source_mm).norm());
     }
   }
   if (widest < kMinRayAngle) {
@@ -396,6 +400,13 @@ Eigen::Vector3d triangulate_linear(std::span<const RadiographView> views,
         "triangulate_linear: degenerate geometry: the rays are parallel (largest angle between "
         "them " +
         std::to_string(widest) + " rad); the views must look from different directions");
+  }
+  // Rays from one focal spot meet only there: the depth along them is not
+  // observed (1e-9 relative: the sources coincide up to rounding).
+  if (baseline <= 1e-9 * (1.0 + reach)) {
+    throw InvalidInputError(
+        "triangulate_linear: degenerate geometry: all views share one source, so the depth "
+        "along the rays is unobservable");
   }
   // Pass 0: unit depths; pass 1: each view's rows divided by the depth found.
   Eigen::Vector3d X = Eigen::Vector3d::Zero();

@@ -116,7 +116,8 @@ Ray backproject(const RadiographView& view, const Eigen::Vector2d& pixel);
 // when fewer than 2 views are given, the counts differ, a pixel is not finite,
 // a view fails validate_view, or the geometry is degenerate: every pair of
 // rays within 1e-6 rad of parallel (e.g. the same view twice), where a pixel
-// of error would move the point by a million pixel sizes along the rays.
+// of error would move the point by a million pixel sizes along the rays, or
+// all views sharing one source (the rays meet only at the focal spot).
 Eigen::Vector3d triangulate_linear(std::span<const RadiographView> views,
                                    std::span<const Eigen::Vector2d> pixels);
 

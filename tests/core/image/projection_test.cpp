@@ -200,6 +200,11 @@ TEST(ProjectionTest, BadInputIsRejected) {
   const std::vector<Eigen::Vector2d> same_pixels = {p0, p0};
   EXPECT_THAT([&] { (void)triangulate_linear(same, same_pixels); },
               ::testing::ThrowsMessage<InvalidInputError>(HasSubstr("degenerate")));
+  // The same source looking at two different pixels: the rays cross only at
+  // the focal spot.
+  const std::vector<Eigen::Vector2d> two_pixels_one_source = {p0, p0 + Eigen::Vector2d(500, 0)};
+  EXPECT_THAT([&] { (void)triangulate_linear(same, two_pixels_one_source); },
+              ::testing::ThrowsMessage<InvalidInputError>(HasSubstr("share one source")));
   // A second view shifted sideways: parallel central rays, no intersection.
   RadiographView shifted = views[0];
   shifted.name = "shifted";
