@@ -8,6 +8,8 @@ BUILD_TYPE ?= Release
 DATA_DIR   ?= $(abspath ../shared/data)
 JOBS       ?= $(shell nproc)
 SUITE      ?= mesh
+ATLAS_DIR  ?= $(BUILD_DIR)/atlas/vhf_right_leg
+RECIPE     ?= schemas/recipes/vhf_right_leg.yaml
 
 # Debian 12 packages needed to build, test and benchmark mmm.
 APT_PACKAGES := build-essential cmake ninja-build pkg-config python3 \
@@ -20,10 +22,17 @@ LINT_PACKAGES := clang-format clang-tidy
 
 .PHONY: demo test build deps deps-lint configure bench format lint clean
 
-# The most complete real job that exists today: check, measure and convert
-# every surface of the atlas data (VHF in mm; OpenSim geometry in m, scaled),
-# then a study of the example workflow (created once; later runs reuse it).
-demo: build
+# The most complete real job that exists today: the default atlas (built when
+# missing or when its recipe changed), checked and pictured; a synthetic
+# patient with its calibrated radiograph pair; a survey of every real surface;
+# a study of the example workflow (created once; later runs reuse it).
+demo: build $(ATLAS_DIR)/atlas.yaml
+	@echo "== mmm demo: check of the default atlas ($(ATLAS_DIR)) =="
+	$(BUILD_DIR)/bin/mmm atlas check $(ATLAS_DIR)
+	$(BUILD_DIR)/bin/mmm atlas show $(ATLAS_DIR) --png $(BUILD_DIR)/demo/atlas.png
+	@echo "== mmm demo: synthetic patient 1 and its frontal/lateral radiographs =="
+	@test -f $(BUILD_DIR)/demo/patient_1/ground_truth.json || \
+	  $(BUILD_DIR)/bin/mmm patient synth --atlas $(ATLAS_DIR) --seed 1 -o $(BUILD_DIR)/demo/patient_1
 	@echo "== mmm demo: survey of the Visible Human Female surfaces =="
 	$(BUILD_DIR)/bin/mmm mesh survey $(DATA_DIR)/vhf --out $(BUILD_DIR)/demo/vhf --lod-faces 2000
 	@echo "== mmm demo: survey of the OpenSim gait2392 bones (m -> mm) =="
@@ -35,8 +44,14 @@ demo: build
 	  --input surface=$(DATA_DIR)/vhf/Right/VHF_Right_Muscle_GluteusMedius_smooth.stl
 	$(BUILD_DIR)/bin/mmm run $(BUILD_DIR)/demo/study -j $(JOBS)
 	$(BUILD_DIR)/bin/mmm status $(BUILD_DIR)/demo/study
-	@echo "Open $(BUILD_DIR)/demo/*/vtp/*.vtp and $(BUILD_DIR)/demo/study/outputs/*.ply in ParaView;"
-	@echo "figures in $(BUILD_DIR)/demo/*/survey.csv and $(BUILD_DIR)/demo/study/outputs/report.json"
+	@echo "Atlas: $(ATLAS_DIR) (picture: $(BUILD_DIR)/demo/atlas.png); patient: $(BUILD_DIR)/demo/patient_1"
+	@echo "  (radiographs/pair_preview.png, ground_truth.json); open $(BUILD_DIR)/demo/*/vtp/*.vtp"
+	@echo "and $(BUILD_DIR)/demo/study/outputs/*.ply in ParaView; figures in $(BUILD_DIR)/demo/*/survey.csv"
+
+# The default atlas: rebuilt when missing or when its recipe changes.
+$(ATLAS_DIR)/atlas.yaml: $(RECIPE) | build
+	@echo "== mmm demo: building the default atlas from $(RECIPE) =="
+	$(BUILD_DIR)/bin/mmm atlas build $(RECIPE) -o $(ATLAS_DIR) --data $(DATA_DIR)
 
 test: build
 	ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS)

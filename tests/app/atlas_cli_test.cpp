@@ -1,0 +1,171 @@
+// The default atlas end to end, on the real data: `mmm atlas build` with the
+// committed recipe, `mmm atlas check`, `mmm atlas show`, and a synthetic
+// patient whose radiographs must show its anatomy where the calibration says.
+// The atlas is built once for the whole suite (about 20 s of CPU).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <variant>
+
+#include "core/atlas/atlas_io.h"
+#include "core/image/png.h"
+#include "core/image/projection.h"
+#include "tests/support/test_data.h"
+
+namespace mmm::app {
+namespace {
+
+using mmm::test::CommandResult;
+using mmm::test::run_mmm;
+
+class AtlasCliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scratch_ = std::make_unique<mmm::test::ScratchDir>("atlas-cli");
+    atlas_ = scratch_->path() / "atlas";
+    const std::filesystem::path recipe =
+        mmm::test::source_dir() / "schemas" / "recipes" / "vhf_right_leg.yaml";
+    build_ = run_mmm("atlas build " + recipe.string() + " -o " + atlas_.string() + " --data " +
+                     mmm::test::data_dir().string());
+  }
+  static void TearDownTestSuite() { scratch_.reset(); }
+
+  static nlohmann::json build_report() {
+    return nlohmann::json::parse(mmm::test::read_text(atlas_ / "build_report.json"));
+  }
+
+  static std::unique_ptr<mmm::test::ScratchDir> scratch_;
+  static std::filesystem::path atlas_;
+  static CommandResult build_;
+};
+
+std::unique_ptr<mmm::test::ScratchDir> AtlasCliTest::scratch_;
+std::filesystem::path AtlasCliTest::atlas_;
+CommandResult AtlasCliTest::build_;
+
+TEST_F(AtlasCliTest, DefaultRecipeBuildsAnAtlasThatPassesItsCheck) {
+  ASSERT_EQ(build_.exit_code, 0) << build_.err;
+  const CommandResult check = run_mmm("atlas check " + atlas_.string() + " --json");
+  ASSERT_EQ(check.exit_code, 0) << check.out << check.err;
+  const nlohmann::json report = nlohmann::json::parse(check.out);
+  EXPECT_TRUE(report["passed"].get<bool>());
+  EXPECT_EQ(report["muscles"].size(), 21U);
+  for (const auto& muscle : report["muscles"]) {
+    // The builder cleans muscles down to 0.5 mm inside bone; the check allows 1.
+    EXPECT_LE(muscle["max_penetration_mm"].get<double>(), 1.0) << muscle["name"];
+    EXPECT_GT(muscle["volume_mm3"].get<double>(), 1e4) << muscle["name"];
+  }
+  const atlas::Atlas atlas = atlas::read_atlas(atlas_);
+  for (const char* name : {"femoral_head_centre_r", "patella_centre_r", "ankle_centre_r", "asis_r",
+                           "lateral_epicondyle_r", "medial_malleolus_r"}) {
+    EXPECT_NE(atlas.find_landmark(name), nullptr) << name;
+  }
+  // The femoral-head centre is the sphere fitted to the VHF head cartilage,
+  // which the data's README puts at about (636.9, 448.9, 883.0) mm.
+  const Eigen::Vector3d head = atlas.find_landmark("femoral_head_centre_r")->position;
+  EXPECT_LT((head - Eigen::Vector3d(636.9, 448.9, 883.0)).norm(), 1.5);
+  EXPECT_EQ(atlas.find_by_tag("quadriceps").size(), 4U);
+}
+
+TEST_F(AtlasCliTest, RegistrationsLandTheirAnchors) {
+  ASSERT_EQ(build_.exit_code, 0) << build_.err;
+  const nlohmann::json report = build_report();
+  int anchored = 0;
+  for (const auto& registration : report["registrations"]) {
+    for (const auto& [name, residual] : registration["anchor_residuals_mm"].items()) {
+      // Anchors (hip centres, femoral head, joint centres) weigh as much as
+      // the whole surface fit: they land within a millimetre.
+      EXPECT_LT(residual.get<double>(), 1.0) << registration["body"] << " " << name;
+      ++anchored;
+    }
+    if (registration["surface_pairs"].get<int>() > 0) {
+      // Generic OpenSim bones onto one subject's: a few mm of shape
+      // difference remain (the gait2392 pelvis is 242 triangles).
+      EXPECT_LT(registration["surface_rms_mm"].get<double>(), 10.0) << registration["body"];
+    }
+  }
+  EXPECT_GE(anchored, 5);
+  // The knee and hip frames mapped through two independent registrations
+  // agree: hip centres coincide, the knee to within a few mm and degrees.
+  for (const auto& joint : report["joints"]) {
+    if (joint["joint"] == "hip_r") {
+      EXPECT_LT(joint["frame_mismatch_mm"].get<double>(), 3.0);
+    }
+    if (joint["joint"] == "knee_r") {
+      EXPECT_LT(joint["frame_mismatch_mm"].get<double>(), 5.0);
+    }
+  }
+}
+
+TEST_F(AtlasCliTest, ShowWritesAPicture) {
+  ASSERT_EQ(build_.exit_code, 0) << build_.err;
+  const std::filesystem::path picture = atlas_.parent_path() / "atlas.png";
+  const CommandResult shown =
+      run_mmm("atlas show " + atlas_.string() + " --png " + picture.string() + " --width 200");
+  ASSERT_EQ(shown.exit_code, 0) << shown.err;
+  const image::PngContent png = image::read_png(picture);
+  ASSERT_TRUE(std::holds_alternative<image::RgbImage8>(png.image));
+  // Four panels side by side (each at most 200 px wide; the side views are
+  // narrower), taller than wide: a standing leg.
+  const image::RgbImage8& rgb = std::get<image::RgbImage8>(png.image);
+  EXPECT_GT(rgb.width, 2 * 200);
+  EXPECT_LE(rgb.width, 4 * 200 + 3 * 10);
+  EXPECT_GT(rgb.height, 200);
+}
+
+TEST_F(AtlasCliTest, SyntheticPatientRadiographsShowItsAnatomyWhereTheCalibrationSays) {
+  ASSERT_EQ(build_.exit_code, 0) << build_.err;
+  const std::filesystem::path patient = atlas_.parent_path() / "patient";
+  // A coarse detector (1.5 mm pitch) keeps the test quick.
+  const CommandResult made = run_mmm("patient synth --atlas " + atlas_.string() +
+                                     " --seed 7 --pixel-pitch 1.5 -o " + patient.string());
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const nlohmann::json truth =
+      nlohmann::json::parse(mmm::test::read_text(patient / "ground_truth.json"));
+  const auto views = image::read_view_sidecar(patient / "radiographs" / "views.json");
+  ASSERT_EQ(views.size(), 2U);
+  for (const image::RadiographFile& file : views) {
+    SCOPED_TRACE(file.view.name);
+    const image::GrayImage16 radiograph =
+        image::read_png_gray16(patient / "radiographs" / file.image);
+    ASSERT_EQ(radiograph.width, file.view.width);
+    std::vector<std::uint16_t> sorted = radiograph.pixels;
+    std::ranges::sort(sorted);
+    const double median = sorted[sorted.size() / 2];
+    for (const char* name : {"femoral_head_centre_r", "patella_centre_r", "ankle_centre_r"}) {
+      const auto& landmark = truth["landmarks"][name];
+      const Eigen::Vector3d position(landmark["position_mm"][0].get<double>(),
+                                     landmark["position_mm"][1].get<double>(),
+                                     landmark["position_mm"][2].get<double>());
+      // The sidecar's matrix projects the ground-truth point where the
+      // ground truth says (same numbers, written and read back).
+      const Eigen::Vector2d pixel = image::project(file.view, position);
+      EXPECT_NEAR(pixel.x(), landmark["pixels"][file.view.name][0].get<double>(), 1e-6);
+      // ... onto bone: brighter (more attenuation) than most of the image,
+      // most of which is air around the leg.
+      const int u = std::clamp(static_cast<int>(pixel.x()), 0, radiograph.width - 1);
+      const int v = std::clamp(static_cast<int>(pixel.y()), 0, radiograph.height - 1);
+      EXPECT_GT(radiograph.at(u, v), median + 2000) << name;
+    }
+  }
+  // Back-projecting the femoral head from both views recovers it (3D -> 2D -> 3D).
+  const auto& head = truth["landmarks"]["femoral_head_centre_r"];
+  const std::array<image::RadiographView, 2> pair = {views[0].view, views[1].view};
+  const std::array<Eigen::Vector2d, 2> pixels = {
+      Eigen::Vector2d(head["pixels"][views[0].view.name][0], head["pixels"][views[0].view.name][1]),
+      Eigen::Vector2d(head["pixels"][views[1].view.name][0],
+                      head["pixels"][views[1].view.name][1])};
+  const Eigen::Vector3d recovered = image::triangulate_linear(pair, pixels);
+  const Eigen::Vector3d expected(head["position_mm"][0], head["position_mm"][1],
+                                 head["position_mm"][2]);
+  // Exact pixels: only rounding separates them.
+  EXPECT_LT((recovered - expected).norm(), 1e-6);
+}
+
+}  // namespace
+}  // namespace mmm::app
