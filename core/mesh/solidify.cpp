@@ -89,6 +89,10 @@ IndexedMesh solidify(const IndexedMesh& mesh, const SolidifyOptions& options) {
     }
   }
   std::vector<Eigen::Vector3d> vertices;
+  // The midpoint of each vertex's grid edge: orientation is decided on these
+  // (never degenerate), as interpolated vertices coincide where w = 1/2 at a
+  // grid point (faces on grid planes) and their normals are rounding noise.
+  std::vector<Eigen::Vector3d> midpoints;
   std::vector<Eigen::Vector3i> faces;
   std::unordered_map<EdgeKey, int, EdgeHash> edge_vertex;
   const auto crossing = [&](long a, long b) {
@@ -99,6 +103,7 @@ IndexedMesh solidify(const IndexedMesh& mesh, const SolidifyOptions& options) {
     const double vb = value[static_cast<std::size_t>(b)];
     const double t = va / (va - vb);
     vertices.push_back((1 - t) * grid.point(a) + t * grid.point(b));
+    midpoints.push_back(0.5 * (grid.point(a) + grid.point(b)));
     const int index = static_cast<int>(vertices.size()) - 1;
     edge_vertex.emplace(key, index);
     return index;
@@ -106,8 +111,8 @@ IndexedMesh solidify(const IndexedMesh& mesh, const SolidifyOptions& options) {
   const auto emit = [&](int p, int q, int r, const Eigen::Vector3d& inside_point,
                         const Eigen::Vector3d& outside_point) {
     const Eigen::Vector3d normal =
-        (vertices[static_cast<std::size_t>(q)] - vertices[static_cast<std::size_t>(p)])
-            .cross(vertices[static_cast<std::size_t>(r)] - vertices[static_cast<std::size_t>(p)]);
+        (midpoints[static_cast<std::size_t>(q)] - midpoints[static_cast<std::size_t>(p)])
+            .cross(midpoints[static_cast<std::size_t>(r)] - midpoints[static_cast<std::size_t>(p)]);
     if (normal.dot(outside_point - inside_point) >= 0) {
       faces.emplace_back(p, q, r);
     } else {
