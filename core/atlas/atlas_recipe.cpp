@@ -247,12 +247,13 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
     const YAML::Node& spec = entry.second;
     if (!spec.IsMap()) reader.fail(spec, field, "expects a mapping {method: ...}");
     reader.check_keys(spec, field,
-                      {"method", "meshes", "targets", "joint_anchor", "head", "condyles",
+                      {"method", "meshes", "targets", "joint_anchor", "joint", "head", "condyles",
                        "acetabulum", "sacrum", "follow", "anisotropic"});
     reg.method = reader.text(spec, "method", field, true);
     reg.meshes = reader.texts(spec, "meshes", field);
     reg.targets = reader.texts(spec, "targets", field);
     reg.joint_anchor = reader.text(spec, "joint_anchor", field);
+    reg.joint = reader.text(spec, "joint", field);
     reg.head = reader.text(spec, "head", field);
     reg.condyles = reader.text(spec, "condyles", field);
     reg.acetabulum = reader.text(spec, "acetabulum", field);
@@ -267,7 +268,8 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
       reader.fail(spec, field + ".meshes",
                   "is required by method " + reg.method + " (the OpenSim meshes to fit)");
     }
-    if (reg.method == "surface") {
+    if (reg.method == "surface" || reg.method == "joint") {
+      if (reg.method == "joint") need(reg.joint, "joint");
       if (reg.targets.empty())
         reader.fail(spec, field + ".targets", "is required by method surface");
       for (const std::string& target : reg.targets) {
@@ -287,7 +289,7 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
     } else {
       reader.fail(spec["method"], field + ".method",
                   "unknown method '" + reg.method +
-                      "' (expected surface, head_and_condyles, hip_and_sacrum or follow)");
+                      "' (expected surface, joint, head_and_condyles, hip_and_sacrum or follow)");
     }
     recipe.registrations.push_back(std::move(reg));
   }

@@ -56,7 +56,7 @@ struct RecipeBone {
 // How one OpenSim body is brought into the atlas frame (see bone_registration.h).
 struct RecipeRegistration {
   std::string body;
-  std::string method;  // "surface", "head_and_condyles", "hip_and_sacrum", "follow"
+  std::string method;  // "surface", "joint", "head_and_condyles", "hip_and_sacrum", "follow"
   // The OpenSim meshes of the body that are fitted (surface: onto `target`;
   // head_and_condyles: the femur; hip_and_sacrum: the sacrum).
   std::vector<std::string> meshes;
@@ -64,6 +64,9 @@ struct RecipeRegistration {
   // surface: a joint whose centre, as placed by the already registered
   // parent body, anchors this (child) body, keeping the chain together.
   std::string joint_anchor;
+  // joint: the body is placed by the parent's map and the motion of this
+  // one-coordinate joint, the coordinate fitted to the target surfaces.
+  std::string joint;
   std::string head;         // head_and_condyles: femoral-head cartilage surface file
   std::string condyles;     // head_and_condyles: distal-femur cartilage surface file
   std::string acetabulum;   // hip_and_sacrum: acetabular cartilage surface file
