@@ -60,7 +60,7 @@ std::optional<Eigen::Vector3d> section_centre(const std::vector<Eigen::Vector3d>
   const std::size_t stride = std::max<std::size_t>(1, n / 24);
   for (std::size_t i = 0; i < n; i += stride) {
     for (std::size_t j = i + stride; j < n; j += stride) {
-      candidates.push_back(0.5 * (section[i] + section[j]));
+      candidates.emplace_back(0.5 * (section[i] + section[j]));
     }
   }
   double best_depth = -1.0;
@@ -104,8 +104,8 @@ std::optional<Eigen::Vector3d> contact_point(const std::vector<Eigen::Vector3d>&
 }
 
 Eigen::Vector3d direction_at(const std::vector<Eigen::Vector3d>& line, std::size_t i) {
-  const Eigen::Vector3d before = line[i > 0 ? i - 1 : 0];
-  const Eigen::Vector3d after = line[std::min(i + 1, line.size() - 1)];
+  const Eigen::Vector3d& before = line[i > 0 ? i - 1 : 0];
+  const Eigen::Vector3d& after = line[std::min(i + 1, line.size() - 1)];
   const Eigen::Vector3d d = after - before;
   return d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::UnitZ();
 }

@@ -41,7 +41,7 @@ Eigen::Matrix3d ground_axes_in_atlas() {
 
 std::filesystem::path data_file(const AtlasBuildOptions& options, const std::string& relative,
                                 const std::string& field) {
-  const std::filesystem::path path = options.data_dir / relative;
+  std::filesystem::path path = options.data_dir / relative;
   if (!std::filesystem::exists(path)) {
     throw IoError(
         path, "not found (recipe field " + field + "; is the data folder right? pass --data DIR)");

@@ -79,7 +79,7 @@ class Reader {
     if (!value.IsSequence()) fail(value, field + "." + key, "expects a list of strings");
     for (std::size_t i = 0; i < value.size(); ++i) {
       if (!value[i].IsScalar()) {
-        fail(value[i], field + "." + key + "[" + std::to_string(i) + "]", "expects a string");
+        fail(value[i], field + "." + key + "[" + std::to_string(i) + ']', "expects a string");
       }
       result.push_back(value[i].as<std::string>());
     }
@@ -108,7 +108,10 @@ class Reader {
       const auto name = entry.first.as<std::string>();
       if (!known.contains(name)) {
         std::string list;
-        for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+        for (const std::string& k : known) {
+          if (!list.empty()) list += ", ";
+          list += k;
+        }
         fail(entry.first, field + "." + name, "unknown field (expected one of: " + list + ")");
       }
     }

@@ -128,7 +128,8 @@ struct AtlasRecipe {
 };
 
 // Reads and checks a recipe. Throws IoError naming the file, the line and
-// the field ("bones[2].body: unknown ... ; did you mean ...") for malformed
+// the field ("line 12:5: bones[2].body: body 'femr_r' has no entry under
+// registration:") for malformed
 // YAML, a missing or ill-typed field, an unknown method or architecture,
 // duplicate names, and references between the recipe's own elements that do
 // not resolve. Files are not opened here.

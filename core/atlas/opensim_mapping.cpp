@@ -24,7 +24,7 @@ const Eigen::Affine3d& body_map(const BodyMaps& maps, const std::string& body,
 }
 
 opensim::Function scaled(const opensim::Function& function, double scale) {
-  return opensim::Function(opensim::MultiplierFunction(function, scale));
+  return {opensim::MultiplierFunction(function, scale)};
 }
 
 Coordinate map_coordinate(const opensim::Coordinate& source) {

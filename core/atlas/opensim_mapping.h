@@ -47,7 +47,7 @@ struct MappedJoint {
 
 // The joint, with frames, coordinates (ranges in rad or mm), axes and rest
 // values. Throws InvalidInputError when a body of the joint has no map.
-MappedJoint map_joint(const opensim::Joint& joint, const BodyMaps& maps);
+MappedJoint map_joint(const opensim::Joint& source, const BodyMaps& maps);
 
 // The action line of an OpenSim muscle; wrap objects it uses are appended to
 // `obstacles` (once each). `rest` holds the atlas's coordinate rest values

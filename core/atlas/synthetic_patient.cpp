@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -69,7 +70,7 @@ image::GrayImage8 preview(const image::GrayImage16& radiograph) {
   image::GrayImage8 picture(radiograph.width, radiograph.height);
   for (std::size_t i = 0; i < radiograph.pixels.size(); ++i) {
     const double t = (radiograph.pixels[i] - low) / (high - low);
-    picture.pixels[i] = static_cast<std::uint8_t>(std::clamp(t, 0.0, 1.0) * 255.0 + 0.5);
+    picture.pixels[i] = static_cast<std::uint8_t>(std::lround(std::clamp(t, 0.0, 1.0) * 255.0));
   }
   return picture;
 }

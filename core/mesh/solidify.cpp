@@ -63,6 +63,11 @@ IndexedMesh solidify(const IndexedMesh& mesh, const SolidifyOptions& options) {
   if (!(h > 0) || !std::isfinite(h)) {
     throw InvalidInputError("solidify: grid_spacing_mm must be a positive number");
   }
+  if (options.padding_cells < 1) {
+    throw InvalidInputError(
+        "solidify: padding_cells must be >= 1 (the grid's outer layer must "
+        "lie outside the solid for the surface to close)");
+  }
   const AabbTree tree(mesh);
   const WindingNumber winding(tree);
   const Eigen::AlignedBox3d box = bounding_box(mesh);
@@ -102,8 +107,8 @@ IndexedMesh solidify(const IndexedMesh& mesh, const SolidifyOptions& options) {
     const double va = value[static_cast<std::size_t>(a)];
     const double vb = value[static_cast<std::size_t>(b)];
     const double t = va / (va - vb);
-    vertices.push_back((1 - t) * grid.point(a) + t * grid.point(b));
-    midpoints.push_back(0.5 * (grid.point(a) + grid.point(b)));
+    vertices.emplace_back((1 - t) * grid.point(a) + t * grid.point(b));
+    midpoints.emplace_back(0.5 * (grid.point(a) + grid.point(b)));
     const int index = static_cast<int>(vertices.size()) - 1;
     edge_vertex.emplace(key, index);
     return index;

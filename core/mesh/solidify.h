@@ -21,11 +21,11 @@ namespace mmm::mesh {
 
 struct SolidifyOptions {
   double grid_spacing_mm = 1.5;  // h, > 0
-  int padding_cells = 2;         // empty cells around the bounding box
+  int padding_cells = 2;         // empty cells around the bounding box, >= 1
 };
 
 // Throws InvalidInputError for an empty or invalid mesh, a non-positive
-// spacing, or a grid above 50 million points (choose a larger spacing).
+// spacing, padding_cells < 1, or a grid above 50 million points (choose a larger spacing).
 IndexedMesh solidify(const IndexedMesh& mesh, const SolidifyOptions& options = {});
 
 }  // namespace mmm::mesh

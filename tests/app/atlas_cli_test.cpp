@@ -1,7 +1,9 @@
 // The default atlas end to end, on the real data: `mmm atlas build` with the
 // committed recipe, `mmm atlas check`, `mmm atlas show`, and a synthetic
 // patient whose radiographs must show its anatomy where the calibration says.
-// The atlas is built once for the whole suite (about 20 s of CPU).
+// The atlas is built once (about 20 s of CPU) and every check runs on it in
+// one test: ctest runs each TEST in its own process, so separate tests would
+// build it again each time.
 
 #include <gtest/gtest.h>
 
@@ -39,6 +41,11 @@ class AtlasCliTest : public ::testing::Test {
     return nlohmann::json::parse(mmm::test::read_text(atlas_ / "build_report.json"));
   }
 
+  static void check_passes();
+  static void anchors_land();
+  static void show_writes_a_picture();
+  static void patient_radiographs_show_the_anatomy();
+
   static std::unique_ptr<mmm::test::ScratchDir> scratch_;
   static std::filesystem::path atlas_;
   static CommandResult build_;
@@ -48,8 +55,7 @@ std::unique_ptr<mmm::test::ScratchDir> AtlasCliTest::scratch_;
 std::filesystem::path AtlasCliTest::atlas_;
 CommandResult AtlasCliTest::build_;
 
-TEST_F(AtlasCliTest, DefaultRecipeBuildsAnAtlasThatPassesItsCheck) {
-  ASSERT_EQ(build_.exit_code, 0) << build_.err;
+void AtlasCliTest::check_passes() {
   const CommandResult check = run_mmm("atlas check " + atlas_.string() + " --json");
   ASSERT_EQ(check.exit_code, 0) << check.out << check.err;
   const nlohmann::json report = nlohmann::json::parse(check.out);
@@ -72,8 +78,7 @@ TEST_F(AtlasCliTest, DefaultRecipeBuildsAnAtlasThatPassesItsCheck) {
   EXPECT_EQ(atlas.find_by_tag("quadriceps").size(), 4U);
 }
 
-TEST_F(AtlasCliTest, RegistrationsLandTheirAnchors) {
-  ASSERT_EQ(build_.exit_code, 0) << build_.err;
+void AtlasCliTest::anchors_land() {
   const nlohmann::json report = build_report();
   int anchored = 0;
   for (const auto& registration : report["registrations"]) {
@@ -102,8 +107,7 @@ TEST_F(AtlasCliTest, RegistrationsLandTheirAnchors) {
   }
 }
 
-TEST_F(AtlasCliTest, ShowWritesAPicture) {
-  ASSERT_EQ(build_.exit_code, 0) << build_.err;
+void AtlasCliTest::show_writes_a_picture() {
   const std::filesystem::path picture = atlas_.parent_path() / "atlas.png";
   const CommandResult shown =
       run_mmm("atlas show " + atlas_.string() + " --png " + picture.string() + " --width 200");
@@ -112,14 +116,13 @@ TEST_F(AtlasCliTest, ShowWritesAPicture) {
   ASSERT_TRUE(std::holds_alternative<image::RgbImage8>(png.image));
   // Four panels side by side (each at most 200 px wide; the side views are
   // narrower), taller than wide: a standing leg.
-  const image::RgbImage8& rgb = std::get<image::RgbImage8>(png.image);
+  const auto& rgb = std::get<image::RgbImage8>(png.image);
   EXPECT_GT(rgb.width, 2 * 200);
   EXPECT_LE(rgb.width, 4 * 200 + 3 * 10);
   EXPECT_GT(rgb.height, 200);
 }
 
-TEST_F(AtlasCliTest, SyntheticPatientRadiographsShowItsAnatomyWhereTheCalibrationSays) {
-  ASSERT_EQ(build_.exit_code, 0) << build_.err;
+void AtlasCliTest::patient_radiographs_show_the_anatomy() {
   const std::filesystem::path patient = atlas_.parent_path() / "patient";
   // A coarse detector (1.5 mm pitch) keeps the test quick.
   const CommandResult made = run_mmm("patient synth --atlas " + atlas_.string() +
@@ -165,6 +168,26 @@ TEST_F(AtlasCliTest, SyntheticPatientRadiographsShowItsAnatomyWhereTheCalibratio
                                  head["position_mm"][2]);
   // Exact pixels: only rounding separates them.
   EXPECT_LT((recovered - expected).norm(), 1e-6);
+}
+
+TEST_F(AtlasCliTest, DefaultRecipeBuildsACheckedAtlasAndSyntheticPatients) {
+  ASSERT_EQ(build_.exit_code, 0) << build_.err;
+  {
+    SCOPED_TRACE("mmm atlas check passes, landmarks and tags are there");
+    check_passes();
+  }
+  {
+    SCOPED_TRACE("the registrations land their anchors; the chain's frames agree");
+    anchors_land();
+  }
+  {
+    SCOPED_TRACE("mmm atlas show writes a picture");
+    show_writes_a_picture();
+  }
+  {
+    SCOPED_TRACE("a synthetic patient's radiographs show its anatomy where the sidecar says");
+    patient_radiographs_show_the_anatomy();
+  }
 }
 
 }  // namespace
