@@ -367,7 +367,6 @@ RegistrationResult Builder::register_through_joint(const RecipeRegistration& reg
   for (const double d : distances) squares += d * d;
   result.rms_mm = std::sqrt(squares / static_cast<double>(distances.size()));
   result.pairs = static_cast<int>(distances.size());
-  result.anchor_residuals_mm.emplace_back(coordinate.name + " (rad)", best_q);
   return result;
 }
 
@@ -734,6 +733,14 @@ AtlasBuildReport Builder::run(const std::filesystem::path& out_dir) {
   if (std::filesystem::exists(out_dir)) std::filesystem::rename(out_dir, previous);
   std::filesystem::rename(partial, out_dir);
   std::filesystem::remove_all(previous);
+  // One note per fact (a muscle with three action lines meets the same bone
+  // three times).
+  std::vector<std::string> notes;
+  std::set<std::string> seen;
+  for (std::string& note : report_.notes) {
+    if (seen.insert(note).second) notes.push_back(std::move(note));
+  }
+  report_.notes = std::move(notes);
   report_.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return report_;
