@@ -79,7 +79,13 @@ class Reader {
     if (!value.IsSequence()) fail(value, field + "." + key, "expects a list of strings");
     for (std::size_t i = 0; i < value.size(); ++i) {
       if (!value[i].IsScalar()) {
-        fail(value[i], field + "." + key + "[" + std::to_string(i) + ']', "expects a string");
+        std::string item = field;
+        item += '.';
+        item += key;
+        item += '[';
+        item += std::to_string(i);
+        item += ']';
+        fail(value[i], item, "expects a string");
       }
       result.push_back(value[i].as<std::string>());
     }
@@ -112,7 +118,13 @@ class Reader {
           if (!list.empty()) list += ", ";
           list += k;
         }
-        fail(entry.first, field + "." + name, "unknown field (expected one of: " + list + ")");
+        std::string message = "unknown field (expected one of: ";
+        message += list;
+        message += ')';
+        std::string where = field;
+        where += '.';
+        where += name;
+        fail(entry.first, where, message);
       }
     }
   }

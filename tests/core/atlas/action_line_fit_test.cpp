@@ -45,7 +45,9 @@ mesh::IndexedMesh swept_tube(const std::vector<Eigen::Vector3d>& centres,
   const int last = first + 1;
   tube.V.row(first) = centres.front().transpose();
   tube.V.row(last) = centres.back().transpose();
-  tube.F.resize(2 * static_cast<Eigen::Index>(rings - 1) * kSegments + 2 * kSegments, 3);
+  tube.F.resize(2 * static_cast<Eigen::Index>(rings - 1) * kSegments +
+                    2 * static_cast<Eigen::Index>(kSegments),
+                3);
   Eigen::Index f = 0;
   for (int k = 0; k + 1 < rings; ++k) {
     for (int j = 0; j < kSegments; ++j) {
