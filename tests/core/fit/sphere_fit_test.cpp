@@ -170,9 +170,8 @@ TEST(SphereFitTest, CoplanarPointsAreRejected) {
   const Eigen::Vector3d v = u.unitOrthogonal();
   Eigen::MatrixX3d plane(25, 3);
   for (int i = 0; i < 25; ++i) {
-    plane.row(i) =
-        (kCenter + static_cast<double>(i % 5) * 3.0 * u + static_cast<double>(i / 5) * 2.0 * v)
-            .transpose();
+    plane.row(i) = (kCenter + static_cast<double>(i % 5) * 3.0 * u + std::floor(i / 5.0) * 2.0 * v)
+                       .transpose();
   }
   EXPECT_THROW(sphere_fit(plane), InvalidInputError);
 }
