@@ -107,8 +107,18 @@ void first_run(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * kNodes);
 }
-BENCHMARK(first_run)->Name("first_run_j1")->Arg(1)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(first_run)->Name("first_run_j2")->Arg(2)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(first_run)
+    ->Name("first_run_j1")
+    ->Arg(1)
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(first_run)
+    ->Name("first_run_j2")
+    ->Arg(2)
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 const std::filesystem::path& finished_study() {
   static const std::filesystem::path kDir = [] {
