@@ -34,6 +34,7 @@ void run_synth(const SynthArgs& args) {
                                  {"height_mm", report.factors.height_mm},
                                  {"stature_scale", report.factors.stature_scale},
                                  {"pelvis_width", report.factors.pelvis_width},
+                                 {"neck_angle_deg", report.factors.neck_angle_deg},
                                  {"segment_length", report.factors.length},
                                  {"segment_width", report.factors.width},
                                  {"image_size", {report.frontal_width, report.frontal_height}},
@@ -46,7 +47,9 @@ void run_synth(const SynthArgs& args) {
             << report.factors.seed << ": stature " << std::setprecision(0)
             << report.factors.height_mm << " mm (scale " << std::setprecision(3)
             << report.factors.stature_scale << "), pelvis width x" << report.factors.pelvis_width
-            << '\n';
+            << ", femoral neck-shaft angle " << std::showpos << std::setprecision(1)
+            << report.factors.neck_angle_deg << std::noshowpos << " deg\n"
+            << std::setprecision(3);
   for (const auto& [bone, factor] : report.factors.length) {
     std::cout << "  " << std::left << std::setw(12) << bone << " length x" << factor << "  width x"
               << report.factors.width.at(bone) << '\n';

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <numbers>
 #include <set>
 
 #include "core/errors.h"
@@ -92,14 +93,53 @@ opensim::Function scaled(const opensim::Function& function, double factor) {
 
 }  // namespace
 
+Eigen::Vector3d NeckWarp::apply(const Eigen::Vector3d& point) const {
+  const Eigen::Vector3d offset = point - head;
+  const double neck_length = (pivot - head).norm();
+  const double across = std::clamp(1.0 - offset.dot(lateral) / neck_length, 0.0, 1.0);
+  const double down = std::clamp(2.0 - offset.dot(distal) / 30.0, 0.0, 1.0);
+  const Eigen::AngleAxisd turn(across * down * angle_rad, axis);
+  return pivot + turn * (point - pivot) + shift;
+}
+
 Eigen::Vector3d PatientDeformation::map_on_bone(const std::string& bone,
                                                 const Eigen::Vector3d& point) const {
   const auto map = bone_maps.find(bone);
   if (map == bone_maps.end()) {
     throw InvalidInputError("patient deformation: no map for bone '" + bone + "'");
   }
-  return map->second * point;
+  return map->second * (bone == neck.bone ? neck.apply(point) : point);
 }
+
+namespace {
+
+// The femur: a child of the root, whose joint has three coordinates, with a
+// distal joint. Sets up the warp's geometry; the angle is set by the caller.
+NeckWarp neck_warp_for(const Atlas& atlas, const Bone& root) {
+  NeckWarp warp;
+  for (const Joint& joint : atlas.joints) {
+    if (joint.parent != root.name || joint.coordinates.size() != 3) continue;
+    const Joint* distal = nullptr;
+    for (const Joint& child : atlas.joints) {
+      if (child.parent == joint.child && child.type != JointType::kWeld) distal = &child;
+    }
+    if (distal == nullptr) continue;
+    warp.bone = joint.child;
+    warp.head = joint.child_frame.translation();
+    warp.distal = (distal->parent_frame.translation() - warp.head).normalized();
+    // Lateral: away from the root's mid-plane, across the bone.
+    const double side = warp.head.x() >= root.frame.translation().x() ? 1.0 : -1.0;
+    Eigen::Vector3d lateral = side * Eigen::Vector3d::UnitX();
+    lateral -= lateral.dot(warp.distal) * warp.distal;
+    warp.lateral = lateral.normalized();
+    warp.axis = warp.distal.cross(warp.lateral).normalized();
+    warp.pivot = warp.head + 45.0 * warp.lateral;
+    return warp;
+  }
+  return warp;
+}
+
+}  // namespace
 
 PatientDeformation make_patient_deformation(const Atlas& atlas, const PatientOptions& options) {
   PatientDeformation deformation;
@@ -121,9 +161,19 @@ PatientDeformation make_patient_deformation(const Atlas& atlas, const PatientOpt
     factors.width[bone.name] = draw(random, options.width_sd);
   }
   const double s = factors.stature_scale;
+  // Drawn after the other factors, so that adding it left every earlier
+  // seed's proportions as they were. draw() gives 1 + sd z (z clipped).
+  factors.neck_angle_deg = (draw(random, options.neck_angle_sd_deg / 100.0) - 1.0) * 100.0;
 
   const Bone* root = nullptr;
-  for (const Bone* bone : chain_order(atlas, root)) {
+  const std::vector<const Bone*> order = chain_order(atlas, root);
+  deformation.neck = neck_warp_for(atlas, *root);
+  if (!deformation.neck.bone.empty()) {
+    NeckWarp& neck = deformation.neck;
+    neck.angle_rad = factors.neck_angle_deg * std::numbers::pi / 180.0;
+    neck.shift = neck.head - neck.apply(neck.head);
+  }
+  for (const Bone* bone : order) {
     const Joint* joint = joint_to(atlas, bone->name);
     Eigen::Affine3d map = Eigen::Affine3d::Identity();
     if (joint == nullptr) {
@@ -154,7 +204,7 @@ PatientDeformation make_patient_deformation(const Atlas& atlas, const PatientOpt
         const Eigen::Matrix3d along = axis * axis.transpose();
         linear = s * (length * along + width * (Eigen::Matrix3d::Identity() - along));
       }
-      const Eigen::Vector3d moved = deformation.bone_maps.at(joint->parent) * proximal;
+      const Eigen::Vector3d moved = deformation.map_on_bone(joint->parent, proximal);
       map.linear() = linear;
       map.translation() = moved - linear * proximal;
     }
@@ -166,11 +216,18 @@ PatientDeformation make_patient_deformation(const Atlas& atlas, const PatientOpt
 Atlas deform_atlas(const Atlas& atlas, const PatientDeformation& deformation) {
   Atlas patient = atlas;
   const auto& maps = deformation.bone_maps;
-  for (Bone& bone : patient.bones) bone.frame = map_frame(maps.at(bone.name), bone.frame);
+  // Frames turn with their bone's affine map; their origins go where the
+  // points of the bone go (the neck warp included).
+  const auto frame_on = [&](const std::string& bone, const Eigen::Isometry3d& frame) {
+    Eigen::Isometry3d mapped = map_frame(maps.at(bone), frame);
+    mapped.translation() = deformation.map_on_bone(bone, frame.translation());
+    return mapped;
+  };
+  for (Bone& bone : patient.bones) bone.frame = frame_on(bone.name, bone.frame);
   for (Joint& joint : patient.joints) {
     const Eigen::Affine3d& parent = maps.at(joint.parent);
-    joint.parent_frame = map_frame(parent, joint.parent_frame);
-    joint.child_frame = map_frame(maps.at(joint.child), joint.child_frame);
+    joint.parent_frame = frame_on(joint.parent, joint.parent_frame);
+    joint.child_frame = frame_on(joint.child, joint.child_frame);
     for (TransformAxis& axis : joint.axes) {
       if (!axis.rotation) axis.function = scaled(axis.function, length_scale(parent));
     }
@@ -179,7 +236,7 @@ Atlas deform_atlas(const Atlas& atlas, const PatientDeformation& deformation) {
     for (ActionLine& line : muscle.action_lines) {
       for (PathPoint& point : line.points) {
         const Eigen::Affine3d& map = maps.at(point.bone);
-        point.position = map * point.position;
+        point.position = deformation.map_on_bone(point.bone, point.position);
         if (point.kind == PathPointKind::kMoving) {
           for (opensim::Function& function : point.moving_functions) {
             function = scaled(function, length_scale(map));
@@ -190,13 +247,13 @@ Atlas deform_atlas(const Atlas& atlas, const PatientDeformation& deformation) {
     for (auto* areas : {&muscle.origins, &muscle.insertions}) {
       for (AttachmentArea& area : *areas) {
         const Eigen::Affine3d& map = maps.at(area.bone);
-        area.centroid = map * area.centroid;
+        area.centroid = deformation.map_on_bone(area.bone, area.centroid);
         area.area_mm2 *= std::pow(length_scale(map), 2);
       }
     }
     for (WrapObstacle& obstacle : muscle.wrap_obstacles) {
       const Eigen::Affine3d& map = maps.at(obstacle.bone);
-      obstacle.pose = map_frame(map, obstacle.pose);
+      obstacle.pose = frame_on(obstacle.bone, obstacle.pose);
       obstacle.radii *= length_scale(map);
     }
   }
@@ -215,9 +272,9 @@ Atlas deform_atlas(const Atlas& atlas, const PatientDeformation& deformation) {
 mesh::IndexedMesh deform_bone_mesh(const PatientDeformation& deformation, const std::string& bone,
                                    const mesh::IndexedMesh& surface) {
   mesh::IndexedMesh mapped = surface;
-  const Eigen::Affine3d& map = deformation.bone_maps.at(bone);
   for (Eigen::Index i = 0; i < mapped.V.rows(); ++i) {
-    mapped.V.row(i) = (map * Eigen::Vector3d(surface.V.row(i))).transpose();
+    mapped.V.row(i) =
+        deformation.map_on_bone(bone, Eigen::Vector3d(surface.V.row(i).transpose())).transpose();
   }
   return mapped;
 }
@@ -226,10 +283,13 @@ mesh::IndexedMesh deform_muscle_mesh(const PatientDeformation& deformation,
                                      const std::map<std::string, mesh::IndexedMesh>& bones,
                                      const mesh::IndexedMesh& surface, double blend_radius_mm) {
   if (bones.empty()) throw InvalidInputError("deform_muscle_mesh: no bone surfaces given");
-  std::vector<std::pair<const Eigen::Affine3d*, mesh::AabbTree>> trees;
+  std::vector<std::pair<std::string, mesh::AabbTree>> trees;
   trees.reserve(bones.size());
   for (const auto& [name, bone] : bones) {
-    trees.emplace_back(&deformation.bone_maps.at(name), mesh::AabbTree(bone));
+    if (!deformation.bone_maps.contains(name)) {
+      throw InvalidInputError("deform_muscle_mesh: no map for bone '" + name + "'");
+    }
+    trees.emplace_back(name, mesh::AabbTree(bone));
   }
   const double eps2 = blend_radius_mm * blend_radius_mm;
   mesh::IndexedMesh mapped = surface;
@@ -237,9 +297,9 @@ mesh::IndexedMesh deform_muscle_mesh(const PatientDeformation& deformation,
     const Eigen::Vector3d p = surface.V.row(i).transpose();
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     double total = 0.0;
-    for (const auto& [map, tree] : trees) {
+    for (const auto& [name, tree] : trees) {
       const double weight = 1.0 / (tree.closest_point(p).squared_distance + eps2);
-      sum += weight * (*map * p);
+      sum += weight * deformation.map_on_bone(name, p);
       total += weight;
     }
     mapped.V.row(i) = (sum / total).transpose();

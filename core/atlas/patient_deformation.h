@@ -10,6 +10,14 @@
 // factor. c'_b = map_parent(c_b) keeps the chain connected. The root (the
 // pelvis) scales about its frame origin, its width (x, mediolateral) by the
 // pelvis-width factor. A bone welded to another follows that bone's map.
+// The femoral neck-shaft angle changes too: on the bone hanging from the
+// root by a ball-like joint with a distal joint (the femur), the head and
+// neck turn by an angle d about the anteroposterior axis through the neck
+// base (pivot 45 mm lateral of the head centre), the turn fading from the
+// head to the pivot and over 30-60 mm down the shaft; the whole bone then
+// shifts so that the head centre stays in the acetabulum (d > 0: the neck
+// turns up, coxa valga). This part is not affine: points on that bone are
+// mapped by map_on_bone (warp, then the bone's affine map).
 // Muscles, which span several bones, move by a partition of unity of the
 // bone maps, weighted by inverse squared distance to each bone's surface
 // (w = 1 / (d^2 + eps^2)), so they stretch smoothly with the segments they
@@ -40,6 +48,9 @@ struct PatientOptions {
   double segment_length_sd = 0.03;
   double width_sd = 0.05;
   double pelvis_width_sd = 0.05;
+  // Neck-shaft angle change (degrees): adults span about 120-140 degrees,
+  // SD ~5 around the mean.
+  double neck_angle_sd_deg = 4.0;
   // Muscle blending: eps in w = 1 / (d^2 + eps^2) (mm).
   double blend_radius_mm = 10.0;
 };
@@ -50,14 +61,31 @@ struct PatientFactors {
   double height_mm = 0.0;
   double stature_scale = 1.0;
   double pelvis_width = 1.0;
+  double neck_angle_deg = 0.0;           // change of the femoral neck-shaft angle
   std::map<std::string, double> length;  // bone -> segment-length factor
   std::map<std::string, double> width;   // bone -> width factor
 };
 
-// The deformation: one affine map per bone (atlas mm -> patient mm).
+// The femoral neck turn (see the file comment), in atlas coordinates.
+struct NeckWarp {
+  std::string bone;  // empty: none
+  Eigen::Vector3d head = Eigen::Vector3d::Zero();
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitY();     // AP, unit
+  Eigen::Vector3d lateral = Eigen::Vector3d::UnitX();  // unit
+  Eigen::Vector3d distal = -Eigen::Vector3d::UnitZ();  // unit, along the bone
+  double angle_rad = 0.0;
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();  // keeps the head centre in place
+
+  [[nodiscard]] Eigen::Vector3d apply(const Eigen::Vector3d& point) const;
+};
+
+// The deformation: one affine map per bone (atlas mm -> patient mm), after
+// the neck warp on the femur.
 struct PatientDeformation {
   PatientFactors factors;
   std::map<std::string, Eigen::Affine3d> bone_maps;
+  NeckWarp neck;
 
   [[nodiscard]] Eigen::Vector3d map_on_bone(const std::string& bone,
                                             const Eigen::Vector3d& point) const;

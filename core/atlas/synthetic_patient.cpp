@@ -165,6 +165,7 @@ SyntheticPatientReport make_synthetic_patient(const std::filesystem::path& atlas
   truth["height_mm"] = deformation.factors.height_mm;
   truth["stature_scale"] = deformation.factors.stature_scale;
   truth["pelvis_width"] = deformation.factors.pelvis_width;
+  truth["neck_angle_deg"] = deformation.factors.neck_angle_deg;
   truth["segment_length"] = deformation.factors.length;
   truth["segment_width"] = deformation.factors.width;
   nlohmann::json landmarks = nlohmann::json::object();

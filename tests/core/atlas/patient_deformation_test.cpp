@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
 #include "core/errors.h"
 #include "core/mesh/mass_properties.h"
 #include "core/mesh/primitives.h"
@@ -121,6 +125,59 @@ TEST(PatientDeformationTest, MuscleBetweenTwoBonesBlendsTheirMaps) {
   // ~ 1e-3 of the thigh's, times a few mm of difference between the maps.
   EXPECT_LT((moved.V - by_thigh.V).rowwise().norm().maxCoeff(), 0.5);
   EXPECT_GT(mesh::signed_volume(moved), 0.0);
+}
+
+}  // namespace
+}  // namespace mmm::atlas
+
+namespace mmm::atlas {
+namespace {
+
+TEST(PatientDeformationTest, FemoralNeckTurnsByItsDrawnAngleAndTheHeadStaysInTheSocket) {
+  // The leg with a ball hip (three coordinates): its thigh gets the neck warp.
+  Atlas atlas = leg();
+  Joint& hip = atlas.joints.front();
+  hip.coordinates.resize(3);
+  hip.coordinates[0].name = "flexion";
+  hip.coordinates[1].name = "adduction";
+  hip.coordinates[2].name = "rotation";
+  // Only the neck angle varies: the affine maps are then translations.
+  PatientOptions options = seeded(11, 1710.0);
+  options.segment_length_sd = options.width_sd = options.pelvis_width_sd = 0.0;
+  double largest = 0.0;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    options.seed = seed;
+    const PatientDeformation deformation = make_patient_deformation(atlas, options);
+    ASSERT_EQ(deformation.neck.bone, "thigh");
+    const double drawn = deformation.factors.neck_angle_deg;
+    largest = std::max(largest, std::abs(drawn));
+    // Within 2.5 SD of 4 degrees (the draw is clipped there).
+    EXPECT_LE(std::abs(drawn), 10.0 + 1e-9);
+    const auto on = [&](const std::string& bone, const Eigen::Vector3d& p) {
+      return deformation.map_on_bone(bone, p);
+    };
+    const Eigen::Vector3d head(0, 0, -50);
+    const Eigen::Vector3d pivot = head + 45.0 * Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d knee(0, 0, -450);
+    // The head centre stays where the pelvis puts it; the chain stays joined.
+    EXPECT_LT((on("pelvis", head) - on("thigh", head)).norm(), 1e-9);
+    EXPECT_LT((on("thigh", knee) - on("shank", knee)).norm(), 1e-9);
+    // The neck axis (pivot -> head) turns by the drawn angle about the AP axis
+    // relative to the shaft (pivot -> knee); rounding only (1e-9 degrees).
+    const auto angle_deg = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+      return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / std::numbers::pi;
+    };
+    const double before = angle_deg(head - pivot, knee - pivot);
+    const double after =
+        angle_deg(on("thigh", head) - on("thigh", pivot), on("thigh", knee) - on("thigh", pivot));
+    EXPECT_NEAR(std::abs(after - before), std::abs(drawn), 1e-9) << "seed " << seed;
+    // The shaft far from the neck is not bent: only shifted.
+    const Eigen::Vector3d shaft_a(0, 0, -200);
+    const Eigen::Vector3d shaft_b(10, 0, -300);
+    EXPECT_LT(((on("thigh", shaft_a) - on("thigh", shaft_b)) - (shaft_a - shaft_b)).norm(), 1e-9);
+  }
+  // Five draws of SD 4 degrees: at least one well away from zero.
+  EXPECT_GT(largest, 1.0);
 }
 
 }  // namespace
