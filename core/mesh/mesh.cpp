@@ -4,9 +4,28 @@
 #include <string>
 #include <vector>
 
+#include <OpenMesh/Core/System/omstream.hh>
+
 #include "core/errors.h"
 
 namespace mmm::mesh {
+namespace {
+
+// OpenMesh's log streams (omlog, omout, omerr) are built by their first
+// caller, and that first construction is not thread-safe: two nodes
+// decimating at once on a fresh process could both connect the stream's
+// targets and corrupt the heap (seen as a rare SIGSEGV of `mmm run -j 2`,
+// in std::vector<basic_multiplex_target*>::_M_realloc_insert). Build them
+// during static initialisation, before any thread exists; this file is
+// linked into every program that converts to OpenMesh (to_halfedge).
+const bool kOpenMeshStreamsReady = [] {
+  omlog();
+  omout();
+  omerr();
+  return true;
+}();
+
+}  // namespace
 
 void validate_indices_and_coordinates(const IndexedMesh& mesh) {
   for (Eigen::Index v = 0; v < mesh.V.rows(); ++v) {
