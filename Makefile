@@ -29,6 +29,7 @@ LINT_PACKAGES := clang-format clang-tidy
 demo: build $(ATLAS_DIR)/atlas.yaml
 	@echo "== mmm demo: check of the default atlas ($(ATLAS_DIR)) =="
 	$(BUILD_DIR)/bin/mmm atlas check $(ATLAS_DIR)
+	@mkdir -p $(BUILD_DIR)/demo
 	$(BUILD_DIR)/bin/mmm atlas show $(ATLAS_DIR) --png $(BUILD_DIR)/demo/atlas.png
 	@echo "== mmm demo: synthetic patient 1 and its frontal/lateral radiographs =="
 	@test -f $(BUILD_DIR)/demo/patient_1/ground_truth.json || \
