@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "core/errors.h"
-#include "workflow/suggest.h"
+#include "core/suggest.h"
 
 namespace mmm::workflow {
 

@@ -33,6 +33,7 @@
 
 #include "core/errors.h"
 #include "core/mesh/io/mesh_io.h"
+#include "core/suggest.h"
 
 namespace mmm::atlas {
 namespace {
@@ -42,44 +43,6 @@ namespace fs = std::filesystem;
 // ---------------------------------------------------------------------------
 // Names, hints, enum tables
 // ---------------------------------------------------------------------------
-
-// Levenshtein distance (core keeps its own: it may not depend on workflow/).
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
-std::string join_names(const std::vector<std::string>& names) {
-  if (names.empty()) return "(none)";
-  std::string out;
-  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
-  return out;
-}
-
-// "; did you mean 'x'?" for the closest candidate within 2 edits, else "".
-std::string did_you_mean(std::string_view name, const std::vector<std::string>& candidates) {
-  constexpr std::size_t kMaxDistance = 2;
-  const std::string* best = nullptr;
-  std::size_t best_distance = kMaxDistance + 1;
-  for (const std::string& candidate : candidates) {
-    const std::size_t distance = edit_distance(name, candidate);
-    if (distance < best_distance && candidate != name) {
-      best = &candidate;
-      best_distance = distance;
-    }
-  }
-  return best == nullptr ? std::string() : "; did you mean '" + *best + "'?";
-}
 
 // The hint after an unknown name: a close match, else the list when short.
 std::string unknown_hint(std::string_view name, const std::vector<std::string>& candidates,

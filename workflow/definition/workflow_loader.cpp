@@ -10,10 +10,10 @@
 #include <utility>
 
 #include "core/errors.h"
+#include "core/suggest.h"
 #include "workflow/definition/workflow_validation.h"
 #include "workflow/definition/yaml_scalar.h"
 #include "workflow/definition/yaml_schema.h"
-#include "workflow/suggest.h"
 
 namespace mmm::workflow {
 namespace {

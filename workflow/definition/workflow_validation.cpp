@@ -7,8 +7,8 @@
 #include <string>
 #include <utility>
 
+#include "core/suggest.h"
 #include "workflow/definition/workflow_graph.h"
-#include "workflow/suggest.h"
 
 namespace mmm::workflow {
 namespace {

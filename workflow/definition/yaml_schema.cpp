@@ -17,8 +17,8 @@
 #include <utility>
 
 #include "core/errors.h"
+#include "core/suggest.h"
 #include "workflow/definition/yaml_scalar.h"
-#include "workflow/suggest.h"
 
 namespace mmm::workflow {
 namespace {

@@ -11,12 +11,12 @@
 #include <utility>
 
 #include "core/errors.h"
+#include "core/suggest.h"
 #include "workflow/definition/workflow_loader.h"
 #include "workflow/host_and_time.h"
 #include "workflow/study/cache_key.h"
 #include "workflow/study/study_database.h"
 #include "workflow/study/value_text.h"
-#include "workflow/suggest.h"
 
 namespace mmm::workflow {
 namespace {

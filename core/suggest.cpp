@@ -1,9 +1,9 @@
-#include "workflow/suggest.h"
+#include "core/suggest.h"
 
 #include <algorithm>
 #include <utility>
 
-namespace mmm::workflow {
+namespace mmm {
 
 std::size_t edit_distance(std::string_view a, std::string_view b) {
   std::vector<std::size_t> row(b.size() + 1);
@@ -52,4 +52,4 @@ std::string did_you_mean(std::string_view name, const std::vector<std::string>& 
   return "; did you mean '" + close.front() + "'?";
 }
 
-}  // namespace mmm::workflow
+}  // namespace mmm
