@@ -1,12 +1,12 @@
 #include "core/atlas/patient_deformation.h"
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <deque>
 #include <numbers>
 #include <set>
 
+#include "core/atlas/bone_registration.h"
 #include "core/errors.h"
 #include "core/mesh/aabb_tree.h"
 
@@ -21,21 +21,9 @@ double draw(std::mt19937_64& random, double sd) {
   return 1.0 + sd * z;
 }
 
-// The rotation closest to a linear map (polar decomposition).
-Eigen::Matrix3d rotation_of(const Eigen::Matrix3d& linear) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(linear, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
-  if (rotation.determinant() < 0) {
-    Eigen::Matrix3d u = svd.matrixU();
-    u.col(2) *= -1;
-    rotation = u * svd.matrixV().transpose();
-  }
-  return rotation;
-}
-
 Eigen::Isometry3d map_frame(const Eigen::Affine3d& map, const Eigen::Isometry3d& frame) {
   Eigen::Isometry3d mapped = Eigen::Isometry3d::Identity();
-  mapped.linear() = rotation_of(map.linear()) * frame.linear();
+  mapped.linear() = nearest_rotation(map.linear()) * frame.linear();
   mapped.translation() = map * frame.translation();
   return mapped;
 }
