@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "core/image/file_bytes.h"
 
 namespace mmm::image {
@@ -500,15 +501,15 @@ PngContent decode_png(const fs::path& path, const std::string& file) {
 }  // namespace
 
 void write_png(const GrayImage8& image, const fs::path& path, const PngWriteOptions& options) {
-  detail::write_file_atomically(path, encode_png(image, kGray, options));
+  write_file_atomically(path, encode_png(image, kGray, options));
 }
 
 void write_png(const GrayImage16& image, const fs::path& path, const PngWriteOptions& options) {
-  detail::write_file_atomically(path, encode_png(image, kGray, options));
+  write_file_atomically(path, encode_png(image, kGray, options));
 }
 
 void write_png(const RgbImage8& image, const fs::path& path, const PngWriteOptions& options) {
-  detail::write_file_atomically(path, encode_png(image, kRgb, options));
+  write_file_atomically(path, encode_png(image, kRgb, options));
 }
 
 PngContent read_png(const fs::path& path) {

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "core/image/file_bytes.h"
 
 namespace mmm::image {
@@ -480,7 +481,7 @@ void write_view_sidecar(const fs::path& path, std::span<const RadiographFile> vi
     text += i + 1 < views.size() ? "    },\n" : "    }\n";
   }
   text += "  ]\n}\n";
-  detail::write_file_atomically(path, text);
+  write_file_atomically(path, text);
 }
 
 std::vector<RadiographFile> read_view_sidecar(const fs::path& path) {

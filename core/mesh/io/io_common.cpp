@@ -4,11 +4,10 @@
 #include <charconv>
 #include <climits>
 #include <cmath>
-#include <fstream>
-#include <random>
 #include <system_error>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 
 namespace mmm::mesh::io_detail {
 
@@ -17,20 +16,6 @@ namespace fs = std::filesystem;
 namespace {
 
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-std::string random_suffix() {
-  std::random_device device;
-  std::string suffix;
-  constexpr std::string_view kHex = "0123456789abcdef";
-  for (int i = 0; i < 4; ++i) {
-    unsigned value = device();
-    for (int k = 0; k < 4; ++k) {
-      suffix.push_back(kHex[value & 0xFU]);
-      value >>= 4U;
-    }
-  }
-  return suffix;
-}
 
 }  // namespace
 
@@ -54,50 +39,11 @@ std::uintmax_t check_mesh_file(const fs::path& path) {
 }
 
 std::string read_whole_file(const fs::path& path) {
-  const std::uintmax_t size = check_mesh_file(path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path, "cannot open the file for reading (check its permissions)");
-  std::string data(static_cast<std::size_t>(size), '\0');
-  in.read(data.data(), static_cast<std::streamsize>(size));
-  const auto got = static_cast<std::uintmax_t>(in.gcount());
-  if (got != size) {
-    throw IoError(path, "could not read the whole file: got " + std::to_string(got) + " of " +
-                            std::to_string(size) + " bytes (is it being written?)");
-  }
-  return data;
+  return read_file_bytes(path, check_mesh_file(path));
 }
 
 void write_file_atomically(const fs::path& path, std::string_view bytes) {
-  std::error_code error;
-  if (fs::is_directory(path, error)) {
-    throw IoError(path, "is a directory; cannot write a mesh file in its place");
-  }
-  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  if (!fs::is_directory(parent, error)) {
-    throw IoError(path, "cannot write: the folder '" + parent.string() +
-                            "' does not exist (create it first)");
-  }
-  const fs::path temp = parent / ("." + path.filename().string() + ".tmp-" + random_suffix());
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      throw IoError(path, "cannot create the temporary file '" + temp.filename().string() +
-                              "' beside it (is the folder writable?)");
-    }
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) {
-      fs::remove(temp, error);
-      throw IoError(path, "writing " + std::to_string(bytes.size()) +
-                              " bytes failed (disk full or quota exceeded?)");
-    }
-  }
-  fs::rename(temp, path, error);
-  if (error) {
-    const std::string reason = error.message();
-    fs::remove(temp, error);
-    throw IoError(path, "cannot move the written temporary file into place: " + reason);
-  }
+  mmm::write_file_atomically(path, bytes, "a mesh file");
 }
 
 void check_mesh_for_writing(const IndexedMesh& mesh, const fs::path& path) {
