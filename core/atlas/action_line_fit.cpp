@@ -113,7 +113,7 @@ Eigen::Vector3d direction_at(const std::vector<Eigen::Vector3d>& line, std::size
 }  // namespace
 
 std::vector<ActionLineFitReport> fit_action_lines(
-    Muscle& muscle, const mesh::IndexedMesh& surface,
+    Muscle& muscle, const mesh::AabbTree& muscle_tree,
     const std::function<bool(const Eigen::Vector3d&)>& inside,
     const std::map<std::string, const mesh::AabbTree*>& bones,
     const ActionLineFitOptions& options) {
@@ -125,8 +125,8 @@ std::vector<ActionLineFitReport> fit_action_lines(
     }
     return *it->second;
   };
-  const mesh::AabbTree muscle_tree(surface);
   const Geometry geometry{muscle_tree, inside};
+  const mesh::IndexedMesh& surface = muscle_tree.mesh();
   // 1. bundles
   std::vector<std::vector<Eigen::Vector3d>> bundles(muscle.action_lines.size());
   std::vector<std::vector<Eigen::Vector3d>> lines;

@@ -579,14 +579,15 @@ void Builder::place_landmarks() {
 }
 
 void Builder::clean_and_attach() {
+  // One signed distance per bone; its tree serves the closest-point queries.
   std::map<std::string, std::unique_ptr<mesh::SignedDistance>> distances;
-  std::map<std::string, std::unique_ptr<mesh::AabbTree>> trees;
+  std::map<std::string, const mesh::AabbTree*> trees;
   for (const auto& [name, surface] : bone_meshes_) {
     if (surface.F.rows() == 0) {
       throw InvalidInputError("atlas build: bone " + name + " has an empty surface");
     }
     distances[name] = std::make_unique<mesh::SignedDistance>(surface);
-    trees[name] = std::make_unique<mesh::AabbTree>(surface);
+    trees[name] = &distances[name]->tree();
   }
   MuscleCleanupOptions cleanup;
   cleanup.tolerance_mm = recipe_.penetration_tolerance_mm;
@@ -615,11 +616,9 @@ void Builder::clean_and_attach() {
 
     const mesh::AabbTree muscle_tree(surface);
     const mesh::WindingNumber winding(muscle_tree);
-    std::map<std::string, const mesh::AabbTree*> bone_trees;
-    for (const auto& [name, tree] : trees) bone_trees[name] = tree.get();
     for (const ActionLineFitReport& fitted : fit_action_lines(
-             muscle, surface, [&](const Eigen::Vector3d& q) { return winding.is_inside(q); },
-             bone_trees)) {
+             muscle, muscle_tree, [&](const Eigen::Vector3d& q) { return winding.is_inside(q); },
+             trees)) {
       report_.action_lines.push_back({muscle.name, fitted.line, fitted.inside_before,
                                       fitted.inside_after, fitted.points_added,
                                       fitted.origin_on_contact, fitted.insertion_on_contact});

@@ -158,7 +158,7 @@ TEST(ActionLineFitTest, LineBesideAStraightMuscleMovesInsideAndOntoTheContacts) 
                  point("insertion", "bottom", {18, 0, -3})};
   muscle.action_lines = {line};
 
-  const auto reports = fit_action_lines(muscle, scene->surface, scene->inside, scene->bones);
+  const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones);
   ASSERT_EQ(reports.size(), 1U);
   const ActionLineFitReport& report = reports.front();
   EXPECT_EQ(report.line, "tube_line");
@@ -202,7 +202,7 @@ TEST(ActionLineFitTest, ArchedMuscleGetsViaPointsAlongItsCurve) {
                  point("insertion", "left_foot", {-60, 0, -5})};
   muscle.action_lines = {line};
 
-  const auto reports = fit_action_lines(muscle, scene.surface, scene.inside, scene.bones);
+  const auto reports = fit_action_lines(muscle, scene.tree, scene.inside, scene.bones);
   ASSERT_EQ(reports.size(), 1U);
   const ActionLineFitReport& report = reports.front();
   EXPECT_LT(report.inside_before, 0.2);
@@ -249,7 +249,7 @@ TEST(ActionLineFitTest, MovingPointsStay) {
                  point("via", "bottom", {0, 0, 50}, PathPointKind::kMoving),
                  point("insertion", "bottom", {0, 0, -3})};
   muscle.action_lines = {line};
-  const auto reports = fit_action_lines(muscle, scene->surface, scene->inside, scene->bones);
+  const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones);
   ASSERT_EQ(reports.size(), 1U);
   EXPECT_FALSE(reports.front().origin_on_contact);
   EXPECT_TRUE(reports.front().insertion_on_contact);
@@ -277,7 +277,7 @@ TEST(ActionLineFitTest, TwoLinesShareTheMuscleIntoBundles) {
   right.name = "right";
   right.points = {point("o", "top", {6, 0, 101}), point("i", "bottom", {6, 0, -1})};
   muscle.action_lines = {left, right};
-  const auto reports = fit_action_lines(muscle, scene->surface, scene->inside, scene->bones);
+  const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones);
   ASSERT_EQ(reports.size(), 2U);
   const ActionLine& l = muscle.action_lines[0];
   const ActionLine& r = muscle.action_lines[1];
@@ -299,7 +299,7 @@ TEST(ActionLineFitTest, UnknownBoneThrows) {
   line.name = "tube_line";
   line.points = {point("origin", "skull", {0, 0, 101}), point("insertion", "bottom", {0, 0, -1})};
   muscle.action_lines = {line};
-  EXPECT_THROW((void)fit_action_lines(muscle, scene->surface, scene->inside, scene->bones),
+  EXPECT_THROW((void)fit_action_lines(muscle, scene->tree, scene->inside, scene->bones),
                InvalidInputError);
 }
 
