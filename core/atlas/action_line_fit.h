@@ -52,11 +52,11 @@ struct ActionLineFitReport {
   bool insertion_on_contact = false;
 };
 
-// Fits every action line of `muscle` (in place). `surface` is the tree of the
+// Fits every action line of `muscle` (in place). `muscle_tree` is the tree of the
 // muscle's surface, `inside` its inside test, `bones` the atlas bones' trees by name
 // (every bone the lines name must be there).
 std::vector<ActionLineFitReport> fit_action_lines(
-    Muscle& muscle, const mesh::AabbTree& surface,
+    Muscle& muscle, const mesh::AabbTree& muscle_tree,
     const std::function<bool(const Eigen::Vector3d&)>& inside,
     const std::map<std::string, const mesh::AabbTree*>& bones,
     const ActionLineFitOptions& options = {});
