@@ -72,7 +72,7 @@ void check_not_collinear(const Eigen::MatrixX3d& centred, const Eigen::VectorXd&
                          const char* which) {
   const Eigen::Matrix3d covariance = centred.transpose() * w.asDiagonal() * centred;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance, Eigen::EigenvaluesOnly);
-  const Eigen::Vector3d variance = solver.eigenvalues();  // ascending
+  const Eigen::Vector3d& variance = solver.eigenvalues();  // ascending
   if (!(variance[1] >= kCollinearVarianceRatio * variance[2]) || !(variance[2] > 0)) {
     throw InvalidInputError(std::string("rigid_fit: the weighted ") + which +
                             " points are collinear or coincide, so the rotation about their "
@@ -103,7 +103,7 @@ struct Similarity {
 Similarity umeyama(const Centred& c, bool with_scale) {
   const Eigen::Matrix3d h = c.q.transpose() * c.w.asDiagonal() * c.p;
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::Vector3d d = svd.singularValues();
+  const Eigen::Vector3d& d = svd.singularValues();
   if (!(d[1] >= kRankRatio * d[0]) || !(d[0] > 0)) {
     throw InvalidInputError(
         "rigid_fit: source and target are uncorrelated across all but one direction, so the "

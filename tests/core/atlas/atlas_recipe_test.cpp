@@ -57,7 +57,7 @@ std::string rejection(const std::string& text) {
     (void)read_atlas_recipe(file);
   } catch (const IoError& error) {
     EXPECT_EQ(error.path(), file);
-    const std::string message = error.what();
+    std::string message = error.what();
     EXPECT_EQ(message.rfind(file.string() + ": ", 0), 0U) << "what() starts with the path";
     return message;
   }
