@@ -1,0 +1,220 @@
+#include "core/landmarks/landmark_validation.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "core/errors.h"
+#include "core/suggest.h"
+
+namespace mmm::landmarks {
+
+namespace {
+
+// "4.6" (one decimal: messages for people, not data).
+std::string mm(double value) {
+  std::array<char, 32> buffer{};
+  std::snprintf(buffer.data(), buffer.size(), "%.1f", value);
+  return buffer.data();
+}
+
+std::string pixel_text(const Eigen::Vector2d& pixel) {
+  return "(" + mm(pixel.x()) + ", " + mm(pixel.y()) + ")";
+}
+
+void check_rules(const ValidationRules& rules) {
+  if (rules.side != "right" && rules.side != "left") {
+    throw InvalidInputError("ValidationRules.side must be \"right\" or \"left\", got \"" +
+                            rules.side + "\"");
+  }
+  const auto finite_non_negative = [](double value, const char* field) {
+    if (!std::isfinite(value) || value < 0) {
+      throw InvalidInputError(std::string("ValidationRules.") + field +
+                              " must be a finite number >= 0, got " + std::to_string(value));
+    }
+  };
+  finite_non_negative(rules.reprojection_tolerance_mm, "reprojection_tolerance_mm");
+  finite_non_negative(rules.side_margin_mm, "side_margin_mm");
+  if (rules.midline_x_mm && !std::isfinite(*rules.midline_x_mm)) {
+    throw InvalidInputError("ValidationRules.midline_x_mm must be finite when set");
+  }
+  for (const DistanceRange& range : rules.distances) {
+    if (!std::isfinite(range.min_mm) || !std::isfinite(range.max_mm) || range.min_mm < 0 ||
+        range.min_mm > range.max_mm) {
+      throw InvalidInputError("ValidationRules.distances: range " + range.from + " - " + range.to +
+                              " must have 0 <= min_mm <= max_mm, got [" +
+                              std::to_string(range.min_mm) + ", " + std::to_string(range.max_mm) +
+                              "]");
+    }
+  }
+  for (const std::string& name : rules.required) {
+    if (std::ranges::find(rules.optional, name) != rules.optional.end()) {
+      throw InvalidInputError("ValidationRules: '" + name + "' is both required and optional");
+    }
+  }
+}
+
+void check_views(std::span<const image::RadiographView> views) {
+  if (views.size() < 2) {
+    throw InvalidInputError("validate_submission: need at least 2 views, got " +
+                            std::to_string(views.size()));
+  }
+  std::set<std::string> names;
+  for (const image::RadiographView& view : views) {
+    image::validate_view(view);
+    if (!names.insert(view.name).second) {
+      throw InvalidInputError("validate_submission: view name '" + view.name + "' is used twice");
+    }
+  }
+}
+
+}  // namespace
+
+double central_ray_crossing_x(std::span<const image::RadiographView> views) {
+  std::vector<Eigen::Vector2d> centres;
+  centres.reserve(views.size());
+  for (const image::RadiographView& view : views) {
+    centres.emplace_back(0.5 * view.width, 0.5 * view.height);
+  }
+  return image::triangulate_linear(views, centres).x();
+}
+
+ValidationResult validate_submission(std::span<const image::RadiographView> views,
+                                     const PixelSubmission& submission,
+                                     const ValidationRules& rules) {
+  check_rules(rules);
+  check_views(views);
+  ValidationResult result;
+  std::vector<std::string>& reasons = result.reasons;
+
+  std::vector<std::string> known = rules.required;
+  known.insert(known.end(), rules.optional.begin(), rules.optional.end());
+  std::vector<std::string> view_names;
+  for (const image::RadiographView& view : views) view_names.push_back(view.name);
+
+  // Names: unknown landmarks, unknown views.
+  for (const auto& [name, by_view] : submission) {
+    if (std::ranges::find(known, name) == known.end()) {
+      reasons.push_back("Landmark '" + name + "' is not one this task asks for" +
+                        did_you_mean(name, known) + " (expected: " + join_names(known) + ").");
+      continue;
+    }
+    for (const auto& [view, pixel] : by_view) {
+      if (std::ranges::find(view_names, view) == view_names.end()) {
+        reasons.push_back("Landmark '" + name + "' is given in view '" + view +
+                          "', which this study does not have" + did_you_mean(view, view_names) +
+                          " (views: " + join_names(view_names) + ").");
+      }
+    }
+  }
+  for (const std::string& name : rules.required) {
+    if (!submission.contains(name)) {
+      reasons.push_back("Required landmark '" + name + "' is missing.");
+    }
+  }
+
+  // Per landmark and view: present, finite, inside; then triangulation.
+  LandmarkSet triangulated;
+  triangulated.frame = "patient";
+  triangulated.source = "radiographs";
+  for (const std::string& name : known) {
+    const auto entry = submission.find(name);
+    if (entry == submission.end()) continue;
+    std::vector<image::RadiographView> used_views;
+    std::vector<Eigen::Vector2d> used_pixels;
+    for (const image::RadiographView& view : views) {
+      const auto given = entry->second.find(view.name);
+      if (given == entry->second.end()) {
+        reasons.push_back("Landmark '" + name + "' is missing in view '" + view.name + "'.");
+        continue;
+      }
+      const Eigen::Vector2d& pixel = given->second;
+      if (!pixel.allFinite()) {
+        reasons.push_back("Landmark '" + name + "' in view '" + view.name +
+                          "' has a pixel position that is not a finite number.");
+        continue;
+      }
+      if (pixel.x() < 0 || pixel.x() > view.width || pixel.y() < 0 || pixel.y() > view.height) {
+        reasons.push_back("Landmark '" + name + "' in view '" + view.name + "' is at pixel " +
+                          pixel_text(pixel) + ", outside the image [0, " +
+                          std::to_string(view.width) + "] x [0, " + std::to_string(view.height) +
+                          "].");
+      }
+      // Still used: a finite pixel just off the image is geometry all the same.
+      used_views.push_back(view);
+      used_pixels.push_back(pixel);
+    }
+    if (used_views.size() < 2) continue;
+    Triangulation solved;
+    try {
+      solved = triangulate(used_views, used_pixels, rules.triangulation);
+    } catch (const std::exception& error) {
+      reasons.push_back("Landmark '" + name + "' could not be triangulated: " + error.what());
+      continue;
+    }
+    Landmark landmark;
+    landmark.name = name;
+    landmark.position_mm = solved.point_mm;
+    for (std::size_t i = 0; i < used_views.size(); ++i) {
+      const std::string& view = used_views[i].name;
+      const double error = solved.reprojection_error_mm[i];
+      landmark.pixels[view] = used_pixels[i];
+      landmark.reprojection_error_mm[view] = error;
+      if (error > rules.reprojection_tolerance_mm) {
+        reasons.push_back("Landmark '" + name + "' in view '" + view + "': reprojection error " +
+                          mm(error) + " mm exceeds the tolerance of " +
+                          mm(rules.reprojection_tolerance_mm) +
+                          " mm; the views disagree on where it is (check its height in each "
+                          "view).");
+      }
+    }
+    triangulated.landmarks.push_back(std::move(landmark));
+  }
+
+  // Anatomy, on the triangulated points.
+  std::vector<const Landmark*> column;
+  for (const std::string& name : rules.top_to_bottom) {
+    if (const Landmark* landmark = triangulated.find(name)) column.push_back(landmark);
+  }
+  for (std::size_t i = 0; i + 1 < column.size(); ++i) {
+    const Landmark& upper = *column[i];
+    const Landmark& lower = *column[i + 1];
+    if (!(upper.position_mm.z() > lower.position_mm.z())) {
+      reasons.push_back("Landmark '" + upper.name + "' (z = " + mm(upper.position_mm.z()) +
+                        " mm) should be above '" + lower.name +
+                        "' (z = " + mm(lower.position_mm.z()) + " mm); were they swapped?");
+    }
+  }
+  for (const DistanceRange& range : rules.distances) {
+    const Landmark* from = triangulated.find(range.from);
+    const Landmark* to = triangulated.find(range.to);
+    if (from == nullptr || to == nullptr) continue;
+    const double distance = (from->position_mm - to->position_mm).norm();
+    if (distance < range.min_mm || distance > range.max_mm) {
+      reasons.push_back("Distance from '" + range.from + "' to '" + range.to + "' is " +
+                        mm(distance) + " mm, outside the adult range [" + mm(range.min_mm) + ", " +
+                        mm(range.max_mm) + "] mm.");
+    }
+  }
+  result.midline_x_mm = rules.midline_x_mm ? *rules.midline_x_mm : central_ray_crossing_x(views);
+  const bool right = rules.side == "right";
+  for (const Landmark& landmark : triangulated.landmarks) {
+    // Lateral distance toward the expected side (+x is the subject's right).
+    const double lateral = right ? landmark.position_mm.x() - result.midline_x_mm
+                                 : result.midline_x_mm - landmark.position_mm.x();
+    if (lateral < rules.side_margin_mm) {
+      reasons.push_back("Landmark '" + landmark.name + "' lies " + mm(std::abs(lateral)) +
+                        " mm to the subject's " + ((lateral >= 0) == right ? "right" : "left") +
+                        " of the midline (x = " + mm(result.midline_x_mm) +
+                        " mm); a landmark of the " + rules.side + " leg must lie at least " +
+                        mm(rules.side_margin_mm) + " mm to the subject's " + rules.side +
+                        " (the other leg clicked?).");
+    }
+  }
+  if (!triangulated.landmarks.empty()) result.landmarks = std::move(triangulated);
+  return result;
+}
+
+}  // namespace mmm::landmarks
