@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <string_view>
 
 #include "core/errors.h"
 
@@ -15,6 +17,13 @@ namespace {
 
 constexpr const char* kFormat = "mmm-landmark-set";
 constexpr int kVersion = 1;
+
+// The parts one after the other (one allocation, for messages built in loops).
+std::string concat(std::initializer_list<std::string_view> parts) {
+  std::string out;
+  for (const std::string_view part : parts) out += part;
+  return out;
+}
 
 std::string landmark_label(std::size_t index, std::string_view name) {
   std::string label = "landmarks[" + std::to_string(index) + "]";
@@ -117,7 +126,7 @@ class Reader {
     }
     LandmarkSet set;
     set.frame = text_field(root, "", "frame");
-    if (set.frame.empty()) fail("", "field 'frame' is empty; hint: \"patient\" or \"lab\"");
+    if (set.frame.empty()) fail("", R"(field 'frame' is empty; hint: "patient" or "lab")");
     set.source = text_field(root, "", "source");
     const Json& list = field(root, "", "landmarks");
     if (!list.is_array()) fail("", "field 'landmarks' must be an array, got " + describe(list));
@@ -161,7 +170,7 @@ std::vector<std::string> LandmarkSet::names() const {
 
 void validate_landmark_set(const LandmarkSet& set) {
   if (set.frame.empty()) {
-    throw InvalidInputError("landmark set: frame is empty; hint: \"patient\" or \"lab\"");
+    throw InvalidInputError(R"(landmark set: frame is empty; hint: "patient" or "lab")");
   }
   std::set<std::string> seen;
   for (std::size_t i = 0; i < set.landmarks.size(); ++i) {
@@ -175,7 +184,7 @@ void validate_landmark_set(const LandmarkSet& set) {
     for (const auto& [view, pixel] : landmark.pixels) {
       if (view.empty()) throw InvalidInputError(where + "pixels has an empty view name");
       if (!pixel.allFinite()) {
-        throw InvalidInputError(where + "pixels." + view + " must be 2 finite numbers");
+        throw InvalidInputError(concat({where, "pixels.", view, " must be 2 finite numbers"}));
       }
     }
     for (const auto& [view, error] : landmark.reprojection_error_mm) {
@@ -183,8 +192,8 @@ void validate_landmark_set(const LandmarkSet& set) {
         throw InvalidInputError(where + "reprojection_error_mm has an empty view name");
       }
       if (!std::isfinite(error) || error < 0) {
-        throw InvalidInputError(where + "reprojection_error_mm." + view +
-                                " must be a finite number >= 0");
+        throw InvalidInputError(
+            concat({where, "reprojection_error_mm.", view, " must be a finite number >= 0"}));
       }
     }
   }

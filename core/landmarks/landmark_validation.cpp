@@ -4,7 +4,9 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <set>
+#include <string_view>
 
 #include "core/errors.h"
 #include "core/suggest.h"
@@ -20,13 +22,20 @@ std::string mm(double value) {
   return buffer.data();
 }
 
+// The parts one after the other (one allocation, for messages built in loops).
+std::string concat(std::initializer_list<std::string_view> parts) {
+  std::string out;
+  for (const std::string_view part : parts) out += part;
+  return out;
+}
+
 std::string pixel_text(const Eigen::Vector2d& pixel) {
   return "(" + mm(pixel.x()) + ", " + mm(pixel.y()) + ")";
 }
 
 void check_rules(const ValidationRules& rules) {
   if (rules.side != "right" && rules.side != "left") {
-    throw InvalidInputError("ValidationRules.side must be \"right\" or \"left\", got \"" +
+    throw InvalidInputError(R"(ValidationRules.side must be "right" or "left", got ")" +
                             rules.side + "\"");
   }
   const auto finite_non_negative = [](double value, const char* field) {
@@ -103,9 +112,9 @@ ValidationResult validate_submission(std::span<const image::RadiographView> view
     }
     for (const auto& [view, pixel] : by_view) {
       if (std::ranges::find(view_names, view) == view_names.end()) {
-        reasons.push_back("Landmark '" + name + "' is given in view '" + view +
-                          "', which this study does not have" + did_you_mean(view, view_names) +
-                          " (views: " + join_names(view_names) + ").");
+        reasons.push_back(concat(
+            {"Landmark '", name, "' is given in view '", view, "', which this study does not have",
+             did_you_mean(view, view_names), " (views: ", join_names(view_names), ")."}));
       }
     }
   }
@@ -163,11 +172,10 @@ ValidationResult validate_submission(std::span<const image::RadiographView> view
       landmark.pixels[view] = used_pixels[i];
       landmark.reprojection_error_mm[view] = error;
       if (error > rules.reprojection_tolerance_mm) {
-        reasons.push_back("Landmark '" + name + "' in view '" + view + "': reprojection error " +
-                          mm(error) + " mm exceeds the tolerance of " +
-                          mm(rules.reprojection_tolerance_mm) +
-                          " mm; the views disagree on where it is (check its height in each "
-                          "view).");
+        reasons.push_back(
+            concat({"Landmark '", name, "' in view '", view, "': reprojection error ", mm(error),
+                    " mm exceeds the tolerance of ", mm(rules.reprojection_tolerance_mm),
+                    " mm; the views disagree on where it is (check its height in each view)."}));
       }
     }
     triangulated.landmarks.push_back(std::move(landmark));

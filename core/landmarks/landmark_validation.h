@@ -67,7 +67,7 @@ struct ValidationRules {
   // cross, i.e. the isocentre of the system (make_biplanar_views: the
   // isocentre x). The operator centres the patient in the field, and the
   // synthetic patients of core/atlas/synthetic_patient.h centre the field on
-  // both hip bones and the right leg: there the isocentre lies ~10 mm to the
+  // both hip bones and the right leg: there the isocentre lies ~8 mm to the
   // right of the midline. Set it when the field is centred on one leg.
   std::optional<double> midline_x_mm;
   // 10 mm: the joint centres of a leg lie 40-100 mm from the midline in a
@@ -86,13 +86,15 @@ struct ValidationRules {
   // lengths as fractions of stature H (Winter, "Biomechanics and Motor
   // Control of Human Movement", 4th ed. 2009, table 4.1: thigh 0.245 H,
   // leg 0.246 H), adult statures 1.40-2.10 m, hence 340-520 mm for either
-  // segment; the patella centre lies 20-60 mm above the knee joint line in
-  // extension, which shortens the hip-patella distance and lengthens the
-  // patella-ankle one; ~15 % margin on each end for anatomical variation.
+  // segment. The patella centre lies 20-60 mm above the knee joint line in
+  // extension, which makes hip-patella 280-500 mm and patella-ankle
+  // 360-580 mm; widened by 30-90 mm each end (a generous low end for the
+  // shank, whose ankle centre is the easier one to misplace upward):
   //   femoral head centre - patella centre: 250-550 mm
   //   patella centre - ankle centre:        270-620 mm
-  // (VHF, 1.71 m: 371 mm and 372 mm; OpenSim gait2392 scaled to subject01,
-  // 1.80 m: femur 0.45 m.)
+  // Checks: the Visible Human Female (data README) has 371 mm from femoral
+  // head to patella; a synthetic patient of the VHF atlas (seed 1) 343 mm and
+  // 382 mm; gait2392 scaled to subject01 (1.80 m) has a 454 mm femur.
   std::vector<DistanceRange> distances = {
       {"femoral_head_centre_r", "patella_centre_r", 250.0, 550.0},
       {"patella_centre_r", "ankle_centre_r", 270.0, 620.0}};

@@ -103,7 +103,7 @@ class MarkupsReader {
     std::string system = "LPS";
     if (const auto it = entry.find("coordinateSystem"); it != entry.end()) {
       if (!it->is_string() || (*it != "LPS" && *it != "RAS")) {
-        fail(where + ".coordinateSystem", "must be \"LPS\" or \"RAS\", got " + describe(*it));
+        fail(where + ".coordinateSystem", R"(must be "LPS" or "RAS", got )" + describe(*it));
       }
       system = it->get<std::string>();
     }
@@ -117,7 +117,7 @@ class MarkupsReader {
       } else if (units == "m") {
         scale = 1e3;
       } else {
-        fail(where + ".coordinateUnits", "must be \"mm\", \"um\" or \"m\", got " + describe(*it));
+        fail(where + ".coordinateUnits", R"(must be "mm", "um" or "m", got )" + describe(*it));
       }
     }
     const auto points = entry.find("controlPoints");
@@ -235,7 +235,7 @@ void write_slicer_markups(const LandmarkSet& set, const fs::path& file,
                           const MarkupsWriteOptions& options) {
   if (options.coordinate_system != "LPS" && options.coordinate_system != "RAS") {
     throw InvalidInputError(
-        "MarkupsWriteOptions.coordinate_system must be \"LPS\" or \"RAS\", got \"" +
+        R"(MarkupsWriteOptions.coordinate_system must be "LPS" or "RAS", got ")" +
         options.coordinate_system + "\"");
   }
   validate_landmark_set(set);

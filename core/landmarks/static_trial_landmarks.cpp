@@ -78,9 +78,8 @@ StaticTrialResult landmarks_from_static_trial(const opensim::MarkerTrajectories&
   const std::string file = trial.source.string();
   const StaticTrialMarkers& names = options.markers;
   if (options.legs != "right" && options.legs != "left" && options.legs != "both") {
-    throw InvalidInputError(
-        "StaticTrialOptions.legs must be \"right\", \"left\" or \"both\", got \"" + options.legs +
-        "\"");
+    throw InvalidInputError(R"(StaticTrialOptions.legs must be "right", "left" or "both", got ")" +
+                            options.legs + "\"");
   }
   if (options.min_valid_frames < 1) {
     throw InvalidInputError("StaticTrialOptions.min_valid_frames must be >= 1, got " +
@@ -177,7 +176,8 @@ StaticTrialResult landmarks_from_static_trial(const opensim::MarkerTrajectories&
   int count = 0;
   for (Eigen::Index f = 0; f < trial.num_frames(); ++f) {
     std::vector<Eigen::Vector3d> p;
-    for (const Eigen::Index marker : pelvis) p.push_back(trial.position(f, marker) * to_mm);
+    p.reserve(pelvis.size());
+    for (const Eigen::Index marker : pelvis) p.emplace_back(trial.position(f, marker) * to_mm);
     if (!std::ranges::all_of(p, [](const Eigen::Vector3d& v) { return v.allFinite(); })) continue;
     const HarringtonHipCentres hips = harrington_hip_centres(p[0], p[1], posterior_point(p));
     width += hips.pelvis_width_mm;

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <utility>
 
 #include "core/errors.h"
 
@@ -14,9 +15,12 @@ namespace {
 
 // Residual of one view: (projection - observed pixel) * pixel spacing (mm).
 struct ReprojectionResidual {
-  ReprojectionResidual(const Eigen::Matrix<double, 3, 4>& P, const Eigen::Vector2d& pixel,
-                       double spacing_mm, double depth_sign)
-      : P_(P), pixel_(pixel), spacing_mm_(spacing_mm), depth_sign_(depth_sign) {}
+  ReprojectionResidual(Eigen::Matrix<double, 3, 4> P, Eigen::Vector2d pixel, double spacing_mm,
+                       double depth_sign)
+      : P_(std::move(P)),
+        pixel_(std::move(pixel)),
+        spacing_mm_(spacing_mm),
+        depth_sign_(depth_sign) {}
 
   template <typename T>
   bool operator()(const T* const X, T* residual) const {
