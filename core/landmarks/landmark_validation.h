@@ -88,8 +88,7 @@ struct ValidationRules {
   // leg 0.246 H), adult statures 1.40-2.10 m, hence 340-520 mm for either
   // segment. The patella centre lies 20-60 mm above the knee joint line in
   // extension, which makes hip-patella 280-500 mm and patella-ankle
-  // 360-580 mm; widened by 30-90 mm each end (a generous low end for the
-  // shank, whose ankle centre is the easier one to misplace upward):
+  // 360-580 mm; widened by 30-90 mm at each end for anatomical variation:
   //   femoral head centre - patella centre: 250-550 mm
   //   patella centre - ankle centre:        270-620 mm
   // Checks: the Visible Human Female (data README) has 371 mm from femoral
