@@ -1,8 +1,11 @@
 #include "nodes/registry.h"
 
 #include "nodes/decimate_mesh.h"
+#include "nodes/landmark_report.h"
 #include "nodes/load_mesh.h"
+#include "nodes/load_radiographs.h"
 #include "nodes/measure_mesh.h"
+#include "worklists/landmark_task.h"
 
 namespace mmm::nodes {
 
@@ -11,6 +14,9 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<LoadMesh>();
   registry.add<DecimateMesh>();
   registry.add<MeasureMesh>();
+  registry.add<LoadRadiographs>();
+  registry.add<worklists::LandmarkStation>();
+  registry.add<LandmarkReport>();
   return registry;
 }
 

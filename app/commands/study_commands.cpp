@@ -16,6 +16,7 @@
 #include "workflow/run/run_study.h"
 #include "workflow/store/study_lock.h"
 #include "workflow/study/study.h"
+#include "worklists/task_actions.h"
 
 namespace mmm::app {
 namespace {
@@ -145,8 +146,15 @@ void run_run(const RunArgs& args, const workflow::NodeRegistry& registry) {
   options.jobs = args.jobs;
   options.provenance = this_program();
   options.observer = args.quiet ? nullptr : display.get();
+  worklists::prepare_worklist_tables(study);
   const workflow::RunSummary summary = workflow::run_study(study, *lock, options);
+  const std::vector<worklists::Task> opened =
+      worklists::open_waiting_tasks(study, {worklists::kSystemOperator, MMM_VERSION});
   print_summary(summary, args.dir);
+  for (const worklists::Task& task : opened) {
+    std::cout << "task " << task.id << " opened for node '" << task.node
+              << "': see 'mmm worklist', 'mmm task show " << task.id << "'\n";
+  }
   switch (summary.outcome) {
     case workflow::RunOutcome::kDone:
       set_exit_code(kExitOk);

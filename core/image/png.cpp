@@ -392,6 +392,20 @@ ImageT to_image(const Header& header, const std::vector<std::uint8_t>& rows) {
   return image;
 }
 
+}  // namespace
+
+void write_png(const GrayImage8& image, const fs::path& path, const PngWriteOptions& options) {
+  write_file_atomically(path, encode_png(image, kGray, options));
+}
+
+void write_png(const GrayImage16& image, const fs::path& path, const PngWriteOptions& options) {
+  write_file_atomically(path, encode_png(image, kGray, options));
+}
+
+void write_png(const RgbImage8& image, const fs::path& path, const PngWriteOptions& options) {
+  write_file_atomically(path, encode_png(image, kRgb, options));
+}
+
 PngContent decode_png(const fs::path& path, const std::string& file) {
   const auto* bytes = reinterpret_cast<const std::uint8_t*>(file.data());
   const std::size_t size = file.size();
@@ -496,20 +510,6 @@ PngContent decode_png(const fs::path& path, const std::string& file) {
     content.image = to_image<RgbaImage8>(header, rows);
   }
   return content;
-}
-
-}  // namespace
-
-void write_png(const GrayImage8& image, const fs::path& path, const PngWriteOptions& options) {
-  write_file_atomically(path, encode_png(image, kGray, options));
-}
-
-void write_png(const GrayImage16& image, const fs::path& path, const PngWriteOptions& options) {
-  write_file_atomically(path, encode_png(image, kGray, options));
-}
-
-void write_png(const RgbImage8& image, const fs::path& path, const PngWriteOptions& options) {
-  write_file_atomically(path, encode_png(image, kRgb, options));
 }
 
 PngContent read_png(const fs::path& path) {

@@ -85,6 +85,11 @@ struct PngContent {
 // the latter with a hint to convert the file.
 PngContent read_png(const std::filesystem::path& path);
 
+// The same from a PNG file's bytes already in memory (e.g. an image held in
+// a study artifact); errors are IoErrors naming `path`, the file the bytes
+// came from.
+PngContent decode_png(const std::filesystem::path& path, const std::string& file);
+
 // The grayscale image of a PNG as 16-bit samples: 16-bit files as stored,
 // 8-bit ones widened exactly (v * 257, so 255 -> 65535). Throws what read_png
 // throws, and IoError when the file holds colour ("holds 8-bit RGB, expected

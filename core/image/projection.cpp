@@ -228,7 +228,10 @@ class SidecarReader {
   }
 
   std::vector<RadiographFile> read() const {
-    const std::string text = detail::read_file_bytes(path_, "a view sidecar (JSON)");
+    return parse(detail::read_file_bytes(path_, "a view sidecar (JSON)"));
+  }
+
+  std::vector<RadiographFile> parse(const std::string& text) const {
     Json root;
     try {
       root = Json::parse(text);
@@ -440,6 +443,10 @@ double reprojection_error_mm(const RadiographView& view, const Eigen::Vector3d& 
 }
 
 void write_view_sidecar(const fs::path& path, std::span<const RadiographFile> views) {
+  write_file_atomically(path, view_sidecar_text(views));
+}
+
+std::string view_sidecar_text(std::span<const RadiographFile> views) {
   if (views.empty()) throw InvalidInputError("write_view_sidecar: no view to write");
   std::set<std::string> names;
   for (const RadiographFile& file : views) {
@@ -481,11 +488,15 @@ void write_view_sidecar(const fs::path& path, std::span<const RadiographFile> vi
     text += i + 1 < views.size() ? "    },\n" : "    }\n";
   }
   text += "  ]\n}\n";
-  write_file_atomically(path, text);
+  return text;
 }
 
 std::vector<RadiographFile> read_view_sidecar(const fs::path& path) {
   return SidecarReader(path).read();
+}
+
+std::vector<RadiographFile> parse_view_sidecar(const std::string& text, const fs::path& path) {
+  return SidecarReader(path).parse(text);
 }
 
 }  // namespace mmm::image

@@ -152,4 +152,10 @@ void write_view_sidecar(const std::filesystem::path& path, std::span<const Radio
 // than 1 is rejected.
 std::vector<RadiographFile> read_view_sidecar(const std::filesystem::path& path);
 
+// The text write_view_sidecar writes, and the reading of such a text already
+// in memory (errors name `path`, where the text came from).
+std::string view_sidecar_text(std::span<const RadiographFile> views);
+std::vector<RadiographFile> parse_view_sidecar(const std::string& text,
+                                               const std::filesystem::path& path);
+
 }  // namespace mmm::image

@@ -1,0 +1,379 @@
+#include "worklists/task_actions.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <optional>
+#include <utility>
+
+#include "workflow/host_and_time.h"
+#include "workflow/run/study_plan.h"
+#include "workflow/study/execution_records.h"
+#include "worklists/audit_trail.h"
+#include "worklists/landmark_task.h"
+#include "worklists/task_store.h"
+
+namespace mmm::worklists {
+namespace {
+
+using Json = nlohmann::json;
+using workflow::Study;
+using workflow::Transaction;
+
+std::string state_text(const Task& task) {
+  std::string text = "task " + task.id + " is " + std::string(task_state_name(task.state));
+  if (!task.assignee.empty()) text += " (assignee " + task.assignee + ")";
+  return text;
+}
+
+Task load(Study& study, const std::string& id) {
+  std::optional<Task> task = find_task(study.database(), id);
+  if (!task) {
+    throw TaskError("study " + study.dir().string() + " has no task " + id +
+                    "; hint: 'mmm worklist --root DIR' lists the tasks");
+  }
+  return std::move(*task);
+}
+
+// The image hashes the operator saw, for the audit trail.
+Json images_of(const Task& task) { return task.request.value("images", Json::object()); }
+
+// Appends the audit entry of one action (inside the caller's transaction).
+void audit(Study& study, const Actor& actor, const Task& task, const std::string& action,
+           const Json& before, const Json& after, const std::string& reason) {
+  AuditEntry entry;
+  entry.action = action;
+  entry.operator_name = actor.operator_name;
+  entry.task_id = task.id;
+  entry.reason = reason;
+  entry.mmm_version = actor.mmm_version;
+  entry.before = before;
+  entry.after = after;
+  entry.images = images_of(task);
+  append_audit_entry(study.database(), std::move(entry));
+}
+
+// Writes the changed task (revision + 1). Throws TaskError when another
+// process changed it since it was read (the loser of a race).
+void save(Study& study, Task& task) {
+  task.updated_at = workflow::utc_now_precise();
+  ++task.revision;
+  if (!update_task(study.database(), task)) {
+    throw TaskError("task " + task.id + " was changed by someone else meanwhile; hint: look at " +
+                    "it again ('mmm task show " + task.id + "')");
+  }
+}
+
+// One action: a write transaction around `change`, then the checkpoint.
+template <class Change>
+auto act(Study& study, const std::string& id, Change&& change) {
+  Transaction transaction(study.database());
+  Task task = load(study, id);
+  auto result = change(task);
+  transaction.commit();
+  write_audit_checkpoint(study.dir(), study.database());
+  return result;
+}
+
+std::string join(const std::vector<std::string>& reasons) {
+  std::string text;
+  for (const std::string& reason : reasons) text += (text.empty() ? "" : "; ") + reason;
+  return text;
+}
+
+ManualEvaluation evaluate(const Task& task, const Json& submission) {
+  if (task.node_type == kLandmarkStationType) {
+    return evaluate_landmark_submission(task, submission);
+  }
+  throw TaskError("node type '" + task.node_type + "' has no manual task support in this mmm");
+}
+
+// Records the evaluated values as the manual node's result: an execution
+// row under the task's cache key, its outputs put in the artifact store.
+std::int64_t record_result(Study& study, const Task& task, const Actor& actor,
+                           const ManualEvaluation& evaluation, const std::string& why) {
+  workflow::ExecutionRecord record;
+  record.node = task.node;
+  record.node_type = task.node_type;
+  record.version = task.key_parts.version;
+  record.cache_key = task.cache_key;
+  record.key_parts = task.key_parts;
+  for (const auto& [port, output] : evaluation.outputs) {
+    record.outputs[port] = {output.type, study.artifacts().put(output.bytes)};
+  }
+  record.status = workflow::ExecutionStatus::kRunning;
+  record.manual = true;
+  record.reason = why;
+  record.started_at = record.finished_at = workflow::utc_now_precise();
+  record.host = workflow::host_name();
+  record.pid = ::getpid();
+  record.submitted_by = actor.operator_name;
+  const std::int64_t id = insert_execution(study.database(), record);
+  record.status = workflow::ExecutionStatus::kDone;
+  workflow::finish_execution(study.database(), id, record,
+                             {{record.finished_at, workflow::LogLevel::kInfo, why}});
+  return id;
+}
+
+void require_operator(const Task& task, const Actor& actor, const std::string& what) {
+  if (task.assignee != actor.operator_name) {
+    throw TaskError(state_text(task) + "; only its assignee can " + what +
+                    " it; hint: 'mmm task claim " + task.id + "' first, or ask " +
+                    (task.assignee.empty() ? std::string("a lead") : task.assignee) +
+                    " to release or reassign it");
+  }
+}
+
+SubmitOutcome accept_values(Study& study, Task& task, const Actor& actor,
+                            const ManualEvaluation& evaluation, const Json& submission,
+                            bool correction, const std::string& reason) {
+  SubmitOutcome outcome;
+  const Json before = task.result;
+  const std::string why = correction ? "correction by " + actor.operator_name + ": " + reason
+                                     : "submitted by " + task.assignee + ", accepted";
+  task.result_execution = record_result(study, task, actor, evaluation, why);
+  task.result = evaluation.values;
+  task.submission = submission;
+  task.state = TaskState::kAccepted;
+  task.rejection_reasons.clear();
+  save(study, task);
+  audit(study, actor, task, correction ? "correct" : "accept", before, task.result, reason);
+  outcome.accepted = true;
+  outcome.correction = correction;
+  outcome.values = evaluation.values;
+  outcome.task = task;
+  return outcome;
+}
+
+}  // namespace
+
+void check_operator_name(const std::string& name) {
+  const bool valid = !name.empty() && name.size() <= 64 &&
+                     std::all_of(name.begin(), name.end(), [](char c) {
+                       return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '.' ||
+                              c == '_' || c == '-' || c == '@';
+                     });
+  if (!valid) {
+    throw TaskError("operator name '" + name +
+                    "' is not valid; hint: 1-64 letters, digits, '.', '_', '-' or '@'");
+  }
+}
+
+void prepare_worklist_tables(Study& study) {
+  {
+    Transaction transaction(study.database());
+    prepare_task_tables(study.database());
+    transaction.commit();
+  }
+  open_audit_trail(study.database(), study.dir());
+}
+
+std::vector<Task> open_waiting_tasks(Study& study, const Actor& actor) {
+  prepare_worklist_tables(study);
+  const workflow::StudyPlan plan = workflow::plan_study(study, false);
+  std::vector<Task> opened;
+  bool changed = false;
+  Transaction transaction(study.database());
+  for (const workflow::NodePlan& node : plan.nodes) {
+    if (!node.type->spec.is_manual() || !node.key_parts) continue;
+    bool has_current = false;
+    for (Task& task : tasks_of_node(study.database(), node.node->id)) {
+      if (task.cache_key == node.cache_key) {
+        has_current = true;
+      } else if (task.state == TaskState::kOpen || task.state == TaskState::kClaimed ||
+                 task.state == TaskState::kSubmitted) {
+        const Json before = task.submission;
+        task.state = TaskState::kCancelled;
+        save(study, task);
+        audit(study, actor, task, "cancel", before, nullptr,
+              "the node's inputs or parameters changed: a new task replaces this one");
+        changed = true;
+      }
+    }
+    if (has_current || node.state != workflow::NodeState::kWaiting) continue;
+    Task task;
+    task.id = new_task_id();
+    task.node = node.node->id;
+    task.node_type = node.type->spec.name();
+    task.cache_key = node.cache_key;
+    task.key_parts = *node.key_parts;
+    task.state = TaskState::kOpen;
+    task.created_at = task.updated_at = workflow::utc_now_precise();
+    if (task.node_type == kLandmarkStationType) {
+      task.request = landmark_task_request(task.key_parts, study.artifacts());
+    }
+    insert_task(study.database(), task);
+    audit(study, actor, task, "open", nullptr, task.request, "");
+    opened.push_back(task);
+    changed = true;
+  }
+  transaction.commit();
+  if (changed) write_audit_checkpoint(study.dir(), study.database());
+  return opened;
+}
+
+Task claim_task(Study& study, const std::string& id, const Actor& actor) {
+  check_operator_name(actor.operator_name);
+  return act(study, id, [&](Task& task) {
+    if (task.state != TaskState::kOpen) {
+      throw TaskError(state_text(task) + ", it cannot be claimed" +
+                      (task.state == TaskState::kClaimed
+                           ? "; hint: ask " + task.assignee + " to release it"
+                           : std::string()));
+    }
+    task.state = TaskState::kClaimed;
+    task.assignee = actor.operator_name;
+    save(study, task);
+    audit(study, actor, task, "claim", nullptr, nullptr, "");
+    return task;
+  });
+}
+
+Task release_task(Study& study, const std::string& id, const Actor& actor) {
+  check_operator_name(actor.operator_name);
+  return act(study, id, [&](Task& task) {
+    if (task.state != TaskState::kClaimed) {
+      throw TaskError(state_text(task) + ", only a claimed task can be released");
+    }
+    require_operator(task, actor, "release");
+    task.state = TaskState::kOpen;
+    task.assignee.clear();
+    save(study, task);
+    audit(study, actor, task, "release", nullptr, nullptr, "");
+    return task;
+  });
+}
+
+Task reassign_task(Study& study, const std::string& id, const Actor& actor,
+                   const std::string& to) {
+  check_operator_name(actor.operator_name);
+  check_operator_name(to);
+  return act(study, id, [&](Task& task) {
+    if (task.state != TaskState::kClaimed && task.state != TaskState::kSubmitted) {
+      throw TaskError(state_text(task) +
+                      ", only a claimed or submitted task can be reassigned; hint: an open task "
+                      "is claimed by whoever takes it");
+    }
+    const Json before = {{"assignee", task.assignee}};
+    task.assignee = to;
+    save(study, task);
+    audit(study, actor, task, "reassign", before, {{"assignee", to}}, "");
+    return task;
+  });
+}
+
+Task cancel_task(Study& study, const std::string& id, const Actor& actor,
+                 const std::string& reason) {
+  check_operator_name(actor.operator_name);
+  if (reason.empty()) throw TaskError("cancelling a task needs a reason (--reason)");
+  return act(study, id, [&](Task& task) {
+    if (task.state == TaskState::kAccepted || task.state == TaskState::kCancelled) {
+      throw TaskError(state_text(task) + ", it cannot be cancelled");
+    }
+    task.state = TaskState::kCancelled;
+    save(study, task);
+    audit(study, actor, task, "cancel", task.submission, nullptr, reason);
+    return task;
+  });
+}
+
+SubmitOutcome submit_task(Study& study, const std::string& id, const Actor& actor,
+                          const Json& submission, const std::string& reason) {
+  check_operator_name(actor.operator_name);
+  return act(study, id, [&](Task& task) {
+    const bool correction = task.state == TaskState::kAccepted;
+    if (correction && reason.empty()) {
+      throw TaskError("task " + task.id + " is already accepted: a correction needs a reason " +
+                      "(--reason \"...\"); it supersedes the values of " + task.assignee +
+                      " and re-runs the downstream nodes");
+    }
+    if (!correction) {
+      if (task.state != TaskState::kClaimed) {
+        throw TaskError(state_text(task) + ", values can only be submitted for a claimed task" +
+                        (task.state == TaskState::kOpen
+                             ? "; hint: 'mmm task claim " + task.id + "' first"
+                             : std::string()));
+      }
+      require_operator(task, actor, "submit for");
+    }
+    const ManualEvaluation evaluation = evaluate(task, submission);
+    audit(study, actor, task, "submit", task.result, submission, reason);
+    if (!evaluation.reasons.empty()) {
+      SubmitOutcome outcome;
+      outcome.reasons = evaluation.reasons;
+      outcome.correction = correction;
+      outcome.values = evaluation.values;
+      if (!correction) {
+        task.state = TaskState::kOpen;
+        task.assignee.clear();
+        task.submission = submission;
+        task.rejection_reasons = evaluation.reasons;
+        save(study, task);
+      }
+      audit(study, actor, task, "reject", submission, nullptr, join(evaluation.reasons));
+      outcome.task = task;
+      return outcome;
+    }
+    if (!correction && task.key_parts.params.contains("review") &&
+        std::get<bool>(task.key_parts.params.at("review"))) {
+      task.state = TaskState::kSubmitted;
+      task.submission = submission;
+      task.rejection_reasons.clear();
+      save(study, task);
+      SubmitOutcome outcome;
+      outcome.awaiting_review = true;
+      outcome.values = evaluation.values;
+      outcome.task = task;
+      return outcome;
+    }
+    return accept_values(study, task, actor, evaluation, submission, correction, reason);
+  });
+}
+
+SubmitOutcome accept_task(Study& study, const std::string& id, const Actor& actor) {
+  check_operator_name(actor.operator_name);
+  return act(study, id, [&](Task& task) {
+    if (task.state != TaskState::kSubmitted) {
+      throw TaskError(state_text(task) + ", only a submitted task awaits review");
+    }
+    if (task.assignee == actor.operator_name) {
+      throw TaskError("task " + task.id + " was submitted by " + actor.operator_name +
+                      ": a second operator must review it");
+    }
+    const ManualEvaluation evaluation = evaluate(task, task.submission);
+    if (!evaluation.reasons.empty()) {
+      throw TaskError("task " + task.id + "'s submission no longer validates: " +
+                      join(evaluation.reasons));
+    }
+    return accept_values(study, task, actor, evaluation, task.submission, false, "reviewed");
+  });
+}
+
+Task reject_task(Study& study, const std::string& id, const Actor& actor,
+                 const std::vector<std::string>& reasons) {
+  check_operator_name(actor.operator_name);
+  if (reasons.empty()) throw TaskError("rejecting a task needs at least one reason (--reason)");
+  return act(study, id, [&](Task& task) {
+    if (task.state != TaskState::kSubmitted) {
+      throw TaskError(state_text(task) + ", only a submitted task can be rejected by a reviewer");
+    }
+    task.state = TaskState::kOpen;
+    task.assignee.clear();
+    task.rejection_reasons = reasons;
+    save(study, task);
+    audit(study, actor, task, "reject", task.submission, nullptr, join(reasons));
+    return task;
+  });
+}
+
+SubmitOutcome preview_submission(Study& study, const std::string& id, const Json& submission) {
+  const Task task = load(study, id);
+  const ManualEvaluation evaluation = evaluate(task, submission);
+  SubmitOutcome outcome;
+  outcome.task = task;
+  outcome.reasons = evaluation.reasons;
+  outcome.values = evaluation.values;
+  return outcome;
+}
+
+}  // namespace mmm::worklists
