@@ -15,7 +15,10 @@ RECIPE     ?= schemas/recipes/vhf_right_leg.yaml
 APT_PACKAGES := build-essential cmake ninja-build pkg-config python3 \
   libeigen3-dev libopenmesh-dev libceres-dev libyaml-cpp-dev libspdlog-dev libfmt-dev \
   libtinyxml2-dev nlohmann-json3-dev libcli11-dev libsqlite3-dev zlib1g-dev \
-  libgtest-dev libgmock-dev googletest libbenchmark-dev
+  libgtest-dev libgmock-dev googletest libbenchmark-dev libcpp-httplib-dev
+# The browser test of the operator web UI (tests/web): headless Chromium and
+# npm for playwright-core (nodejs itself may come from Debian or NodeSource).
+WEB_TEST_PACKAGES := chromium
 # Extra tools used by .ci/run (format and static analysis).
 LINT_PACKAGES := clang-format clang-tidy
 
@@ -66,7 +69,10 @@ configure:
 # Installs only the packages that are missing, so it is quiet and fast when
 # everything is there (idempotent).
 deps:
-	@./cmake/install_apt_packages.sh $(APT_PACKAGES)
+	@./cmake/install_apt_packages.sh $(APT_PACKAGES) $(WEB_TEST_PACKAGES)
+	@command -v npm >/dev/null || ./cmake/install_apt_packages.sh nodejs npm
+	@test tests/web/node_modules/.package-lock.json -nt tests/web/package-lock.json || \
+	  (cd tests/web && npm ci --no-audit --no-fund)
 
 deps-lint:
 	@./cmake/install_apt_packages.sh $(LINT_PACKAGES)

@@ -27,6 +27,8 @@ int run(int argc, char** argv) {
   const mmm::workflow::NodeRegistry registry = mmm::nodes::make_node_registry();
   mmm::app::register_workflow_commands(app, registry);
   mmm::app::register_study_commands(app, registry);
+  mmm::app::register_task_commands(app, registry);
+  mmm::app::register_serve_commands(app, registry);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -25,6 +25,13 @@ void register_patient_commands(CLI::App& app);
 // mmm study create|set, mmm run, mmm status, mmm explain
 void register_study_commands(CLI::App& app, const workflow::NodeRegistry& registry);
 
+// mmm worklist, mmm task claim|release|reassign|submit|accept|reject|cancel|show,
+// mmm audit verify|show, mmm operator add|list
+void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registry);
+
+// mmm serve: the operator web UI (the registry must outlive the server)
+void register_serve_commands(CLI::App& app, const workflow::NodeRegistry& registry);
+
 // Exit codes of every command (documented in the README).
 inline constexpr int kExitOk = 0;       // done
 inline constexpr int kExitFailed = 1;   // the command (or a node) failed; message says why
