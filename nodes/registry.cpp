@@ -1,10 +1,12 @@
 #include "nodes/registry.h"
 
 #include "nodes/decimate_mesh.h"
+#include "nodes/import_markups.h"
 #include "nodes/landmark_report.h"
 #include "nodes/load_mesh.h"
 #include "nodes/load_radiographs.h"
 #include "nodes/measure_mesh.h"
+#include "nodes/static_trial_landmarks.h"
 #include "worklists/landmark_task.h"
 
 namespace mmm::nodes {
@@ -17,6 +19,8 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<LoadRadiographs>();
   registry.add<worklists::LandmarkStation>();
   registry.add<LandmarkReport>();
+  registry.add<ImportMarkups>();
+  registry.add<StaticTrialLandmarks>();
   return registry;
 }
 
