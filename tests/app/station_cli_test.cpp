@@ -1,0 +1,126 @@
+// The landmark station from the command line: a study of
+// schemas/examples/landmark_station.yaml pauses (exit 3) with a task on the
+// worklist; an operator claims and submits pixels; a rejected submission
+// lists its reasons (exit 1); an accepted one resumes the study (exit 0);
+// `mmm audit verify` passes, then catches an edited entry.
+
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <nlohmann/json.hpp>
+
+#include "core/image/png.h"
+#include "core/image/projection.h"
+#include "tests/support/test_data.h"
+
+namespace mmm {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using test::CommandResult;
+using test::run_mmm;
+
+class StationCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    image::BiplanarOptions options;
+    options.isocentre_mm = {0, 0, 500};
+    options.detector_pixel_pitch_mm = 4.0;
+    std::vector<image::RadiographFile> files;
+    for (const image::RadiographView& view : image::make_biplanar_views(options)) {
+      image::write_png(image::GrayImage16(view.width, view.height),
+                       dir_ / (view.name + ".png"));
+      files.push_back({view, view.name + ".png"});
+      views_.push_back(view);
+    }
+    image::write_view_sidecar(dir_ / "views.json", files);
+    fs::create_directories(root_);
+    const CommandResult created = run_mmm(
+        "study create " + study_.string() + " -w " +
+        (test::source_dir() / "schemas/examples/landmark_station.yaml").string() +
+        " --input calibration=" + (dir_ / "views.json").string() +
+        " --input frontal=" + (dir_ / "frontal.png").string() +
+        " --input lateral=" + (dir_ / "lateral.png").string() + " --input patient=P042");
+    ASSERT_EQ(created.exit_code, 0) << created.err;
+  }
+
+  std::string point(const std::string& name, const Eigen::Vector3d& X) const {
+    std::string text;
+    for (const image::RadiographView& view : views_) {
+      const Eigen::Vector2d uv = image::project(view, X);
+      text += " --point " + name + ":" + view.name + "=" + std::to_string(uv.x()) + "," +
+              std::to_string(uv.y());
+    }
+    return text;
+  }
+
+  std::string task_id() const {
+    const CommandResult listed = run_mmm("worklist --root " + root_.string() + " --json");
+    EXPECT_EQ(listed.exit_code, 0) << listed.err;
+    const Json tasks = Json::parse(listed.out);
+    EXPECT_EQ(tasks.size(), 1U) << listed.out;
+    return tasks.empty() ? std::string() : tasks[0]["task"].get<std::string>();
+  }
+
+  test::ScratchDir dir_{"station-cli"};
+  fs::path root_ = dir_ / "studies";
+  fs::path study_ = root_ / "p42";
+  std::vector<image::RadiographView> views_;
+};
+
+TEST_F(StationCliTest, PauseSubmitRejectedThenAcceptedResumesAndTheAuditVerifies) {
+  const CommandResult paused = run_mmm("run " + study_.string() + " -q");
+  EXPECT_EQ(paused.exit_code, 3) << paused.out << paused.err;
+  const std::string id = task_id();
+  ASSERT_EQ(id.size(), 10U);
+  const CommandResult table = run_mmm("worklist --root " + root_.string());
+  EXPECT_NE(table.out.find("P042"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("open"), std::string::npos) << table.out;
+
+  const std::string task = " --root " + root_.string();
+  const CommandResult claimed = run_mmm("task claim " + id.substr(0, 5) + task + " --operator ana");
+  EXPECT_EQ(claimed.exit_code, 0) << claimed.err;
+  EXPECT_EQ(run_mmm("task claim " + id + task + " --operator ben").exit_code, 1);
+
+  const Eigen::Vector3d head(90, 0, 900);
+  const Eigen::Vector3d patella(80, 30, 480);
+  // The patella placed above the femoral head: rejected, with the reason.
+  const CommandResult rejected = run_mmm("task submit " + id + task + " --operator ana" +
+                                         point("femoral_head_centre_r", patella) +
+                                         point("patella_centre_r", head));
+  EXPECT_EQ(rejected.exit_code, 1);
+  EXPECT_NE(rejected.err.find("rejected"), std::string::npos) << rejected.err;
+  EXPECT_NE(rejected.err.find("above"), std::string::npos) << rejected.err;
+
+  ASSERT_EQ(run_mmm("task claim " + id + task + " --operator ana").exit_code, 0);
+  const CommandResult accepted =
+      run_mmm("task submit " + id + task + " --operator ana" +
+              point("femoral_head_centre_r", head) + point("patella_centre_r", patella));
+  EXPECT_EQ(accepted.exit_code, 0) << accepted.out << accepted.err;
+  EXPECT_NE(accepted.out.find("study resumed"), std::string::npos) << accepted.out;
+  const Json report = Json::parse(test::read_text(study_ / "outputs/landmark_report.json"));
+  EXPECT_NEAR(report["distances_mm"]["femoral_head_centre_r-patella_centre_r"].get<double>(),
+              (head - patella).norm(), 1e-3);
+
+  const CommandResult verified = run_mmm("audit verify " + study_.string());
+  EXPECT_EQ(verified.exit_code, 0) << verified.err;
+  const CommandResult csv = run_mmm("audit show " + study_.string() + " --csv");
+  EXPECT_NE(csv.out.find("ana"), std::string::npos);
+
+  // Someone edits the operator of an entry behind mmm's back.
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((study_ / "study.db").c_str(), &db), SQLITE_OK);
+  sqlite3_exec(db, "DROP TRIGGER IF EXISTS audit_no_update", nullptr, nullptr, nullptr);
+  sqlite3_exec(db, "DROP TRIGGER IF EXISTS audit_no_delete", nullptr, nullptr, nullptr);
+  ASSERT_EQ(sqlite3_exec(db, "UPDATE audit SET operator_name = 'ben' WHERE seq = 2", nullptr,
+                         nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  const CommandResult tampered = run_mmm("audit verify " + study_.string());
+  EXPECT_EQ(tampered.exit_code, 1);
+  EXPECT_NE(tampered.err.find("entry 2"), std::string::npos) << tampered.err;
+}
+
+}  // namespace
+}  // namespace mmm
