@@ -30,11 +30,10 @@ std::string base64_encode(std::string_view bytes) {
   text.reserve((bytes.size() + 2) / 3 * 4);
   std::size_t i = 0;
   for (; i + 3 <= bytes.size(); i += 3) {
-    const std::uint32_t group = static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i]))
-                                    << 16U |
-                                static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i + 1]))
-                                    << 8U |
-                                static_cast<unsigned char>(bytes[i + 2]);
+    const std::uint32_t group =
+        static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i])) << 16U |
+        static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i + 1])) << 8U |
+        static_cast<unsigned char>(bytes[i + 2]);
     text += kAlphabet[(group >> 18U) & 63U];
     text += kAlphabet[(group >> 12U) & 63U];
     text += kAlphabet[(group >> 6U) & 63U];
@@ -43,7 +42,8 @@ std::string base64_encode(std::string_view bytes) {
   const std::size_t rest = bytes.size() - i;
   if (rest > 0) {
     std::uint32_t group = static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i])) << 16U;
-    if (rest == 2) group |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i + 1])) << 8U;
+    if (rest == 2)
+      group |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i + 1])) << 8U;
     text += kAlphabet[(group >> 18U) & 63U];
     text += kAlphabet[(group >> 12U) & 63U];
     text += rest == 2 ? kAlphabet[(group >> 6U) & 63U] : '=';

@@ -23,8 +23,8 @@ void LoadRadiographs::run(workflow::NodeContext& context) {
   const auto& calibration = context.input("calibration");
   std::vector<image::RadiographFile> views =
       image::parse_view_sidecar(context.input_bytes("calibration"), calibration.path);
-  const std::map<std::string, std::string> images = {
-      {"frontal", context.input_bytes("frontal")}, {"lateral", context.input_bytes("lateral")}};
+  const std::map<std::string, std::string> images = {{"frontal", context.input_bytes("frontal")},
+                                                     {"lateral", context.input_bytes("lateral")}};
   const image::RadiographPair pair =
       image::make_radiograph_pair(std::move(views), images, calibration.path.parent_path());
   for (const image::RadiographFile& file : pair.views) {

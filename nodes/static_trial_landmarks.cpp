@@ -22,7 +22,8 @@ void StaticTrialLandmarks::run(workflow::NodeContext& context) {
       opensim::parse_trc(context.input_bytes("trial"), context.input("trial").path);
   landmarks::StaticTrialOptions options;
   options.legs = context.text("legs");
-  const landmarks::StaticTrialResult result = landmarks::landmarks_from_static_trial(trial, options);
+  const landmarks::StaticTrialResult result =
+      landmarks::landmarks_from_static_trial(trial, options);
   context.info("pelvis width " + std::to_string(result.pelvis_width_mm) + " mm, depth " +
                std::to_string(result.pelvis_depth_mm) + " mm");
   for (const landmarks::StaticTrialLandmarkInfo& info : result.info) {

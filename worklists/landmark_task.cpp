@@ -159,7 +159,8 @@ Json landmark_task_request(const workflow::CacheKeyParts& parts,
   request["instructions"] = std::get<std::string>(param(parts, "instructions"));
   request["side"] = side;
   request["review"] = std::get<bool>(param(parts, "review"));
-  request["reprojection_tolerance_mm"] = std::get<double>(param(parts, "reprojection_tolerance_mm"));
+  request["reprojection_tolerance_mm"] =
+      std::get<double>(param(parts, "reprojection_tolerance_mm"));
   request["radiographs"] = input->second;
   request["patient"] = "";
   if (const auto patient = parts.input_hashes.find("patient");
@@ -204,8 +205,7 @@ ManualEvaluation evaluate_landmark_submission(const Task& task, const Json& subm
   const std::vector<image::RadiographView> views = views_of(task.request);
   const landmarks::ValidationResult result =
       landmarks::validate_submission(views, pixels, rules_of(task.request));
-  evaluation.reasons.insert(evaluation.reasons.end(), result.reasons.begin(),
-                            result.reasons.end());
+  evaluation.reasons.insert(evaluation.reasons.end(), result.reasons.begin(), result.reasons.end());
   evaluation.values = Json::object();
   if (result.landmarks) evaluation.values = Json(*result.landmarks);
   if (evaluation.reasons.empty() && result.landmarks) {

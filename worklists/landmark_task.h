@@ -23,8 +23,8 @@
 //               "pixel_spacing_mm": 0.38, "P": [[...], [...], [...]],
 //               "image_sha256": "..."}, ...],
 //    "images": {"frontal": "<sha256>", "lateral": "<sha256>"},
-//    "radiographs": "<artifact hash>", "patient": "P001", "reprojection_tolerance_mm": 3, "side": "right",
-//    "review": false}
+//    "radiographs": "<artifact hash>", "patient": "P001",
+//    "reprojection_tolerance_mm": 3, "side": "right", "review": false}
 // A submission gives each landmark's pixel position in each view:
 //   {"landmarks": {"femoral_head_centre_r": {"frontal": [u, v], "lateral": [u, v]}, ...}}
 // Anything malformed in it is a reason to reject, never an exception.
@@ -54,7 +54,6 @@ nlohmann::json landmark_task_request(const workflow::CacheKeyParts& parts,
                                      const workflow::ArtifactStore& artifacts);
 
 // Triangulates and validates a submission against the task's request.
-ManualEvaluation evaluate_landmark_submission(const Task& task,
-                                              const nlohmann::json& submission);
+ManualEvaluation evaluate_landmark_submission(const Task& task, const nlohmann::json& submission);
 
 }  // namespace mmm::worklists

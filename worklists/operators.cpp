@@ -72,8 +72,7 @@ std::vector<OperatorRecord> read_operators(const fs::path& root) {
       throw IoError(file, "operators[" + std::to_string(operators.size()) +
                               "] needs a 'name' and a 'token_sha256' string");
     }
-    operators.push_back({entry["name"].get<std::string>(),
-                         entry["token_sha256"].get<std::string>(),
+    operators.push_back({entry["name"].get<std::string>(), entry["token_sha256"].get<std::string>(),
                          entry.value("created_at", "")});
   }
   return operators;

@@ -18,10 +18,10 @@ StudyRunResult run_study_with_tasks(workflow::Study& study, const workflow::RunO
   }
   prepare_worklist_tables(study);
   result.summary = workflow::run_study(study, *lock, options);
-  result.opened = open_waiting_tasks(
-      study, {kSystemOperator, options.provenance.mmm_version.empty()
-                                   ? std::string("unknown")
-                                   : options.provenance.mmm_version});
+  result.opened =
+      open_waiting_tasks(study, {kSystemOperator, options.provenance.mmm_version.empty()
+                                                      ? std::string("unknown")
+                                                      : options.provenance.mmm_version});
   return result;
 }
 

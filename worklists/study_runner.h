@@ -15,7 +15,7 @@
 namespace mmm::worklists {
 
 struct StudyRunResult {
-  bool locked = false;  // another runner holds the study: nothing was run
+  bool locked = false;      // another runner holds the study: nothing was run
   std::string lock_holder;  // who, when locked (the lock error's text)
   std::optional<workflow::RunSummary> summary;
   std::vector<Task> opened;  // tasks opened after the run

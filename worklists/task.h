@@ -50,8 +50,8 @@ struct Task {
   // What is needed, for the operator (names, images, instructions): the
   // node type's own document (landmark_task.h for the station).
   nlohmann::json request = nlohmann::json::object();
-  nlohmann::json submission;  // the latest submission as given (null: none)
-  nlohmann::json result;      // the accepted values (null: none)
+  nlohmann::json submission;                   // the latest submission as given (null: none)
+  nlohmann::json result;                       // the accepted values (null: none)
   std::vector<std::string> rejection_reasons;  // of the latest rejection
   std::int64_t result_execution = 0;           // execution row of the accepted result
   int revision = 0;                            // +1 at every change

@@ -148,11 +148,11 @@ SubmitOutcome accept_values(Study& study, Task& task, const Actor& actor,
 }  // namespace
 
 void check_operator_name(const std::string& name) {
-  const bool valid = !name.empty() && name.size() <= 64 &&
-                     std::all_of(name.begin(), name.end(), [](char c) {
-                       return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '.' ||
-                              c == '_' || c == '-' || c == '@';
-                     });
+  const bool valid =
+      !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '.' || c == '_' ||
+               c == '-' || c == '@';
+      });
   if (!valid) {
     throw TaskError("operator name '" + name +
                     "' is not valid; hint: 1-64 letters, digits, '.', '_', '-' or '@'");
@@ -244,8 +244,7 @@ Task release_task(Study& study, const std::string& id, const Actor& actor) {
   });
 }
 
-Task reassign_task(Study& study, const std::string& id, const Actor& actor,
-                   const std::string& to) {
+Task reassign_task(Study& study, const std::string& id, const Actor& actor, const std::string& to) {
   check_operator_name(actor.operator_name);
   check_operator_name(to);
   return act(study, id, [&](Task& task) {
@@ -342,8 +341,8 @@ SubmitOutcome accept_task(Study& study, const std::string& id, const Actor& acto
     }
     const ManualEvaluation evaluation = evaluate(task, task.submission);
     if (!evaluation.reasons.empty()) {
-      throw TaskError("task " + task.id + "'s submission no longer validates: " +
-                      join(evaluation.reasons));
+      throw TaskError("task " + task.id +
+                      "'s submission no longer validates: " + join(evaluation.reasons));
     }
     return accept_values(study, task, actor, evaluation, task.submission, false, "reviewed");
   });

@@ -34,8 +34,8 @@ void collect(const fs::path& dir, int depth, std::vector<fs::path>& studies) {
 // Seconds since the epoch of "2026-11-22T14:03:00.123Z" (0 when unreadable).
 double utc_seconds(const std::string& text) {
   std::tm tm{};
-  if (text.size() < 19 || ::strptime(text.substr(0, 19).c_str(), "%Y-%m-%dT%H:%M:%S", &tm) ==
-                              nullptr) {
+  if (text.size() < 19 ||
+      ::strptime(text.substr(0, 19).c_str(), "%Y-%m-%dT%H:%M:%S", &tm) == nullptr) {
     return 0;
   }
   double seconds = static_cast<double>(::timegm(&tm));
@@ -44,8 +44,7 @@ double utc_seconds(const std::string& text) {
 }
 
 double now_seconds() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
 std::string patient_of(workflow::Database& database, const fs::path& dir) {
@@ -88,8 +87,7 @@ std::vector<WorklistEntry> list_worklist(const fs::path& root, const WorklistFil
     if (!has_tasks_table(database)) continue;
     const std::string patient = patient_of(database, dir);
     for (Task& task : all_tasks(database)) {
-      const bool closed =
-          task.state == TaskState::kAccepted || task.state == TaskState::kCancelled;
+      const bool closed = task.state == TaskState::kAccepted || task.state == TaskState::kCancelled;
       if (filter.state ? task.state != *filter.state : (closed && !filter.include_closed)) {
         continue;
       }

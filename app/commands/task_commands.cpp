@@ -87,8 +87,7 @@ void run_worklist(const WorklistArgs& args) {
   if (!args.state.empty()) {
     filter.state = worklists::task_state_from_name(args.state);
     if (!filter.state) {
-      throw InvalidInputError("--state '" + args.state +
-                              "' is not a task state; hint: one of " +
+      throw InvalidInputError("--state '" + args.state + "' is not a task state; hint: one of " +
                               worklists::task_state_names());
     }
   }
@@ -146,8 +145,8 @@ void add_point(Json& submission, const std::string& text) {
   } catch (const std::exception&) {
     throw InvalidInputError("--point '" + text + "': U and V must be numbers (pixels)");
   }
-  submission["landmarks"][text.substr(0, colon)][text.substr(colon + 1, equals - colon - 1)] = {
-      u, v};
+  submission["landmarks"][text.substr(0, colon)][text.substr(colon + 1, equals - colon - 1)] = {u,
+                                                                                                v};
 }
 
 Json read_submission(const TaskArgs& args) {
@@ -164,8 +163,9 @@ Json read_submission(const TaskArgs& args) {
   }
   for (const std::string& point : args.points) add_point(submission, point);
   if (args.file.empty() && args.points.empty()) {
-    throw InvalidInputError("nothing to submit; hint: --file SUBMISSION.json or --point "
-                            "NAME:VIEW=U,V (repeat for each landmark and view)");
+    throw InvalidInputError(
+        "nothing to submit; hint: --file SUBMISSION.json or --point "
+        "NAME:VIEW=U,V (repeat for each landmark and view)");
   }
   return submission;
 }
@@ -247,7 +247,8 @@ void run_task_action(const std::string& action, const TaskArgs& args,
     }
     if (!task.rejection_reasons.empty()) {
       std::cout << "  last rejection:\n";
-      for (const std::string& reason : task.rejection_reasons) std::cout << "    - " << reason << '\n';
+      for (const std::string& reason : task.rejection_reasons)
+        std::cout << "    - " << reason << '\n';
     }
     if (!task.result.is_null()) {
       std::cout << "  accepted values:\n";
@@ -273,10 +274,9 @@ void run_task_action(const std::string& action, const TaskArgs& args,
     std::cout << "task " << id << " rejected, back to open\n";
   } else if (action == "submit" || action == "accept") {
     const worklists::SubmitOutcome outcome =
-        action == "submit"
-            ? worklists::submit_task(study, id, actor, read_submission(args),
-                                     joined_reasons(args.reasons))
-            : worklists::accept_task(study, id, actor);
+        action == "submit" ? worklists::submit_task(study, id, actor, read_submission(args),
+                                                    joined_reasons(args.reasons))
+                           : worklists::accept_task(study, id, actor);
     print_values(outcome.values);
     if (!outcome.reasons.empty()) {
       std::cerr << (outcome.correction ? "correction" : "submission") << " rejected ("
@@ -315,8 +315,8 @@ void run_audit(const std::string& action, const std::string& dir, const std::str
       std::cout << "audit trail intact: " << verification.entries << " entries, head "
                 << verification.head_seq << " " << verification.head.substr(0, 16) << "...\n";
     } else {
-      std::cerr << "audit trail NOT intact: " << verification.problems.size()
-                << " problem(s) in " << dir << '\n';
+      std::cerr << "audit trail NOT intact: " << verification.problems.size() << " problem(s) in "
+                << dir << '\n';
       set_exit_code(kExitFailed);
     }
     return;
@@ -344,7 +344,8 @@ void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registr
       "worklist", "Tasks waiting for operators, across every study under a root folder");
   worklist->add_option("--root", worklist_args->root,
                        "Folder holding the studies (default: $MMM_ROOT, else .)");
-  worklist->add_option("--operator", worklist_args->assignee, "Only tasks assigned to this operator");
+  worklist->add_option("--operator", worklist_args->assignee,
+                       "Only tasks assigned to this operator");
   worklist->add_option("--state", worklist_args->state,
                        "Only tasks in this state (" + worklists::task_state_names() + ")");
   worklist->add_flag("--all", worklist_args->all, "Also accepted and cancelled tasks");
@@ -380,12 +381,12 @@ void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registr
   }
   {
     auto [command, args] = add_action(
-        "submit", "Submit landmark pixels; validated, then accepted or rejected with reasons", true);
+        "submit", "Submit landmark pixels; validated, then accepted or rejected with reasons",
+        true);
     command->add_option("--file", args->file,
                         "Submission JSON: {\"landmarks\": {NAME: {VIEW: [u, v]}}}");
     command->add_option("--point", args->points, "NAME:VIEW=U,V (pixels); repeatable");
-    command->add_option("--reason", args->reasons,
-                        "Why: required to correct an accepted task");
+    command->add_option("--reason", args->reasons, "Why: required to correct an accepted task");
     command->add_flag("--no-run", args->no_run, "Do not continue the study's run afterwards");
     command->add_option("--jobs,-j", args->jobs, "Nodes run at the same time when continuing")
         ->check(CLI::Range(1, 256));
@@ -410,7 +411,8 @@ void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registr
   auto audit_dir = std::make_shared<std::string>();
   auto audit_format = std::make_shared<std::string>("table");
   auto* verify = audit->add_subcommand(
-      "verify", "Check the hash chain and its checkpoint: edits, deletions, reordering, truncation");
+      "verify",
+      "Check the hash chain and its checkpoint: edits, deletions, reordering, truncation");
   verify->add_option("DIR", *audit_dir, "Study folder")->required();
   verify->callback([audit_dir, &registry] { run_audit("verify", *audit_dir, "", registry); });
   auto* show = audit->add_subcommand("show", "Every entry (table, --json or --csv)");

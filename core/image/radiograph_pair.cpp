@@ -39,9 +39,9 @@ void check_image(const RadiographFile& file, const std::string& png, const fs::p
                   "holds colour, a radiograph must be grayscale (convert it first)");
   }
   if (width != file.view.width || height != file.view.height) {
-    throw IoError(source / file.image, file.image + " is " + size_text(width, height) +
-                                           ", the calibration of view '" + file.view.name +
-                                           "' says " + size_text(file.view.width, file.view.height));
+    throw IoError(source / file.image,
+                  file.image + " is " + size_text(width, height) + ", the calibration of view '" +
+                      file.view.name + "' says " + size_text(file.view.width, file.view.height));
   }
 }
 

@@ -29,19 +29,18 @@ class StationCliTest : public ::testing::Test {
     options.detector_pixel_pitch_mm = 4.0;
     std::vector<image::RadiographFile> files;
     for (const image::RadiographView& view : image::make_biplanar_views(options)) {
-      image::write_png(image::GrayImage16(view.width, view.height),
-                       dir_ / (view.name + ".png"));
+      image::write_png(image::GrayImage16(view.width, view.height), dir_ / (view.name + ".png"));
       files.push_back({view, view.name + ".png"});
       views_.push_back(view);
     }
     image::write_view_sidecar(dir_ / "views.json", files);
     fs::create_directories(root_);
-    const CommandResult created = run_mmm(
-        "study create " + study_.string() + " -w " +
-        (test::source_dir() / "schemas/examples/landmark_station.yaml").string() +
-        " --input calibration=" + (dir_ / "views.json").string() +
-        " --input frontal=" + (dir_ / "frontal.png").string() +
-        " --input lateral=" + (dir_ / "lateral.png").string() + " --input patient=P042");
+    const CommandResult created =
+        run_mmm("study create " + study_.string() + " -w " +
+                (test::source_dir() / "schemas/examples/landmark_station.yaml").string() +
+                " --input calibration=" + (dir_ / "views.json").string() +
+                " --input frontal=" + (dir_ / "frontal.png").string() +
+                " --input lateral=" + (dir_ / "lateral.png").string() + " --input patient=P042");
     ASSERT_EQ(created.exit_code, 0) << created.err;
   }
 
@@ -86,9 +85,9 @@ TEST_F(StationCliTest, PauseSubmitRejectedThenAcceptedResumesAndTheAuditVerifies
   const Eigen::Vector3d head(90, 0, 900);
   const Eigen::Vector3d patella(80, 30, 480);
   // The patella placed above the femoral head: rejected, with the reason.
-  const CommandResult rejected = run_mmm("task submit " + id + task + " --operator ana" +
-                                         point("femoral_head_centre_r", patella) +
-                                         point("patella_centre_r", head));
+  const CommandResult rejected =
+      run_mmm("task submit " + id + task + " --operator ana" +
+              point("femoral_head_centre_r", patella) + point("patella_centre_r", head));
   EXPECT_EQ(rejected.exit_code, 1);
   EXPECT_NE(rejected.err.find("rejected"), std::string::npos) << rejected.err;
   EXPECT_NE(rejected.err.find("above"), std::string::npos) << rejected.err;

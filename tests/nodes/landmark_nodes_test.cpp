@@ -67,7 +67,8 @@ TEST(LandmarkReportTest, ReportsDistancesAlongTheLegAndReprojectionErrors) {
   set.landmarks.push_back({"patella_centre_r", {0, 30, 500}, {{"frontal", 1.5}}, {}});
   set.landmarks.push_back({"ankle_centre_r", {0, 0, 100}, {}, {}});
   const auto outputs = harness.run<LandmarkReport>(
-      {{"landmarks", harness.add(PortType::kLandmarkSet, landmarks::landmark_set_to_json_text(set))}});
+      {{"landmarks",
+        harness.add(PortType::kLandmarkSet, landmarks::landmark_set_to_json_text(set))}});
   const Json report = Json::parse(mmm::test::read_text(outputs.at("report").path));
   EXPECT_NEAR(report["distances_mm"]["femoral_head_centre_r-patella_centre_r"].get<double>(),
               std::hypot(30.0, 400.0), 1e-9);
@@ -87,8 +88,9 @@ TEST(ImportMarkupsTest, ReadsAnLpsPointListIntoThePatientFrame) {
       harness.run<ImportMarkups>({{"markups", harness.add(PortType::kFile, file)}});
   const landmarks::LandmarkSet set = read_set(outputs.at("landmarks"));
   ASSERT_NE(set.find("femoral_head_centre_r"), nullptr);
-  EXPECT_TRUE(set.find("femoral_head_centre_r")->position_mm.isApprox(
-      Eigen::Vector3d(90, 5, 900)));  // LPS -> RAS: x and y change sign
+  EXPECT_TRUE(
+      set.find("femoral_head_centre_r")
+          ->position_mm.isApprox(Eigen::Vector3d(90, 5, 900)));  // LPS -> RAS: x and y change sign
   EXPECT_EQ(set.source, "slicer_markups");
 }
 
@@ -101,9 +103,9 @@ TEST(StaticTrialLandmarksTest, RealStaticTrialGivesAPlausibleFemurLength) {
   ASSERT_NE(set.find("femoral_head_centre_r"), nullptr);
   ASSERT_NE(set.find("knee_centre_r"), nullptr);
   EXPECT_EQ(set.find("femoral_head_centre_l"), nullptr);
-  const double femur = (set.find("femoral_head_centre_r")->position_mm -
-                        set.find("knee_centre_r")->position_mm)
-                           .norm();
+  const double femur =
+      (set.find("femoral_head_centre_r")->position_mm - set.find("knee_centre_r")->position_mm)
+          .norm();
   // The OpenSim-scaled model of this subject has a 454 mm femur.
   EXPECT_NEAR(femur, 454.1, 15.0);
   EXPECT_EQ(set.frame, "lab");

@@ -240,8 +240,7 @@ TEST_P(TaskRejectionTest, AnInvalidSubmissionIsRejectedWithItsReasonAndTheTaskRe
 INSTANTIATE_TEST_SUITE_P(
     EachRule, TaskRejectionTest,
     ::testing::Values(
-        RejectionCase{"MissingRequired",
-                      [](Json& s) { s["landmarks"].erase("patella_centre_r"); },
+        RejectionCase{"MissingRequired", [](Json& s) { s["landmarks"].erase("patella_centre_r"); },
                       "patella_centre_r"},
         RejectionCase{"OutsideTheImage",
                       [](Json& s) {
@@ -275,8 +274,7 @@ TEST_F(TaskActionsTest, ACorrectionNeedsAReasonSupersedesAndRerunsOnlyDownstream
   ASSERT_TRUE(submit_task(study, id, ana_, submission(false)).accepted);
   ASSERT_EQ(run(study).summary->outcome, workflow::RunOutcome::kDone);
   EXPECT_THROW(submit_task(study, id, ben_, submission()), TaskError) << "no reason";
-  const SubmitOutcome corrected =
-      submit_task(study, id, ben_, submission(), "ankle centre added");
+  const SubmitOutcome corrected = submit_task(study, id, ben_, submission(), "ankle centre added");
   ASSERT_TRUE(corrected.accepted);
   EXPECT_TRUE(corrected.correction);
   const StudyRunResult rerun = run(study);
@@ -337,8 +335,8 @@ TEST_F(TaskActionsTest, EveryActionIsAuditedAndTheTrailVerifies) {
     EXPECT_EQ(entry.task_id, id);
     EXPECT_EQ(entry.images.size(), 2U) << "the hashes of the images shown";
   }
-  EXPECT_THAT(actions, ElementsAre("open", "claim", "submit", "reject", "claim", "submit",
-                                   "accept"));
+  EXPECT_THAT(actions,
+              ElementsAre("open", "claim", "submit", "reject", "claim", "submit", "accept"));
   EXPECT_TRUE(verify_audit(study.database(), study.dir()).intact);
 }
 

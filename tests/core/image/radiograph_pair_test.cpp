@@ -77,8 +77,7 @@ TEST_F(RadiographPairTest, AMissingImageNamesItsPath) {
 
 TEST_F(RadiographPairTest, ADamagedSerialisationIsRejected) {
   std::string text = radiograph_pair_to_json_text(load_radiograph_pair(dir_ / "views.json"));
-  EXPECT_THROW((void)radiograph_pair_from_json_text(text.substr(0, text.size() / 2), "a"),
-               IoError);
+  EXPECT_THROW((void)radiograph_pair_from_json_text(text.substr(0, text.size() / 2), "a"), IoError);
   const std::size_t at = text.find("png_base64\":\"") + 20;
   text[at] = text[at] == 'A' ? 'B' : 'A';
   try {
