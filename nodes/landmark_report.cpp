@@ -1,6 +1,7 @@
 #include "nodes/landmark_report.h"
 
 #include <algorithm>
+#include <array>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -32,9 +33,9 @@ void LandmarkReport::run(workflow::NodeContext& context) {
   report["landmarks"] = positions;
   nlohmann::json distances = nlohmann::json::object();
   for (const char* side : {"_r", "_l"}) {
-    const std::string chain[] = {std::string("femoral_head_centre") + side,
-                                 std::string("patella_centre") + side,
-                                 std::string("ankle_centre") + side};
+    const std::array<std::string, 3> chain = {std::string("femoral_head_centre") + side,
+                                              std::string("patella_centre") + side,
+                                              std::string("ankle_centre") + side};
     for (int i = 0; i + 1 < 3; ++i) {
       const landmarks::Landmark* a = set.find(chain[i]);
       const landmarks::Landmark* b = set.find(chain[i + 1]);

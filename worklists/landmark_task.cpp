@@ -1,6 +1,7 @@
 #include "worklists/landmark_task.h"
 
 #include <Eigen/LU>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -20,7 +21,7 @@ struct LandmarkText {
   const char* hint;
 };
 
-constexpr LandmarkText kLandmarks[] = {
+constexpr std::array<LandmarkText, 3> kLandmarks = {{
     {"femoral_head_centre", "Femoral head centre",
      "the centre of the circle that best fits the femoral head's outline, in both views"},
     {"patella_centre", "Patella centre",
@@ -29,7 +30,7 @@ constexpr LandmarkText kLandmarks[] = {
     {"ankle_centre", "Ankle centre",
      "frontal: midway between the tips of the medial and lateral malleoli; lateral: the centre "
      "of the talar dome's arc"},
-};
+}};
 
 constexpr const char* kDefaultInstructions =
     "Place each landmark in the frontal view and in the lateral view. The horizontal guide line "
@@ -103,8 +104,9 @@ landmarks::PixelSubmission parse_submission(const Json& submission,
     pixels[name];  // named, even without a view: validation reports what is missing
     for (const auto& [view, uv] : views.items()) {
       if (!uv.is_array() || uv.size() != 2 || !uv[0].is_number() || !uv[1].is_number()) {
-        reasons.push_back("landmark '" + name + "' in view '" + view +
-                          "': the position must be [u, v], two numbers (pixels)");
+        std::string reason = "landmark '" + name;
+        reason += "' in view '" + view + "': the position must be [u, v], two numbers (pixels)";
+        reasons.push_back(std::move(reason));
         continue;
       }
       pixels[name][view] = {uv[0].get<double>(), uv[1].get<double>()};

@@ -17,6 +17,7 @@ struct ManualOutput {
   std::string bytes;
 };
 
+// NOLINTNEXTLINE(bugprone-exception-escape): nlohmann::json's noexcept move only asserts
 struct ManualEvaluation {
   std::vector<std::string> reasons;
   nlohmann::json values;

@@ -85,7 +85,7 @@ std::string add_operator(const fs::path& root, const std::string& name, bool rep
     throw IoError(root, "is not a folder; hint: --root names the folder that holds the studies");
   }
   std::vector<OperatorRecord> operators = read_operators(root);
-  const std::string token = random_token();
+  std::string token = random_token();
   const OperatorRecord record{name, hash::sha256_hex(token), workflow::utc_now()};
   bool found = false;
   for (OperatorRecord& existing : operators) {

@@ -38,7 +38,7 @@ double utc_seconds(const std::string& text) {
       ::strptime(text.substr(0, 19).c_str(), "%Y-%m-%dT%H:%M:%S", &tm) == nullptr) {
     return 0;
   }
-  double seconds = static_cast<double>(::timegm(&tm));
+  auto seconds = static_cast<double>(::timegm(&tm));
   if (text.size() > 20 && text[19] == '.') seconds += std::stod("0" + text.substr(19, 4));
   return seconds;
 }

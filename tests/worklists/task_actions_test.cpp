@@ -169,6 +169,7 @@ TEST_F(TaskActionsTest, OfRacingClaimsExactlyOneWins) {
   std::atomic<int> won{0};
   std::atomic<int> lost{0};
   std::vector<std::thread> operators;
+  operators.reserve(6);
   for (int i = 0; i < 6; ++i) {
     operators.emplace_back([&, i] {
       Study own = open();  // its own database connection, as another process would have
