@@ -99,7 +99,15 @@ TEST(WorkflowCliTest, NodesJsonIsMachineReadable) {
   const CommandResult result = run_mmm("nodes --json");
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const auto json = nlohmann::json::parse(result.out);
-  ASSERT_EQ(json["node_types"].size(), 3U);
+  std::vector<std::string> names;
+  for (const auto& type : json["node_types"]) {
+    names.push_back(type["name"].get<std::string>());
+    EXPECT_EQ(type["manual"].get<bool>(), type["name"] == "landmark_station") << type["name"];
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"decimate_mesh", "import_markups", "landmark_report",
+                                             "landmark_station", "load_mesh", "load_radiographs",
+                                             "measure_mesh", "static_trial_landmarks"}))
+      << "sorted by name";
   const auto& decimate = json["node_types"][0];
   EXPECT_EQ(decimate["name"], "decimate_mesh");
   EXPECT_EQ(decimate["inputs"][0]["type"], "Mesh");
