@@ -271,9 +271,10 @@ void check_factor(const char* what, const char* segment, double factor, double p
                   double atlas_mm, const ScalingOptions& options) {
   if (!(factor >= options.min_length_factor && factor <= options.max_length_factor)) {
     std::ostringstream message;
-    message << what << ": the " << segment << " length factor " << factor << " (patient "
-            << patient_mm << " mm, atlas " << atlas_mm << " mm) is outside the plausible range ["
-            << options.min_length_factor << ", " << options.max_length_factor
+    message << what << ": the " << segment << " length factor " << factor << " (landmark distance "
+            << patient_mm << " mm, in the atlas " << atlas_mm
+            << " mm) is outside the plausible range [" << options.min_length_factor << ", "
+            << options.max_length_factor
             << "]: check the landmark placement (names swapped? wrong units?)";
     throw InvalidInputError(message.str());
   }
@@ -441,7 +442,7 @@ ScalingEstimate estimate_anatomical_scaling(const atlas::Atlas& atlas,
   }
   estimate.knee_rotation_deg = shape.knee_angle_rad * 180.0 / std::numbers::pi;
   if (!targets.ankle) {
-    estimate.notes.push_back(
+    estimate.notes.emplace_back(
         "two landmarks fix one length: every bone scales by |P - H| / |P0 - H0| (the tibia "
         "assumed to scale like the femur) and the leg's rotation about the H-P line is the "
         "atlas's; this is the uniform baseline");

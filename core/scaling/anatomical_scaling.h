@@ -34,7 +34,8 @@
 // knee) for the tibia and the bones hanging from it, I elsewhere; G = (R, t)
 // a global rigid motion. Bones welded to a parent take the parent's map;
 // the root (the pelvis) scales by s and, like every bone, goes through G,
-// which puts the hip centre where the femoral head is.
+// which puts the femoral-head landmark on H (so the hip centre, which the
+// pelvis and femur maps share, sits where the patient's femoral head is).
 //
 // Estimation (three landmarks):
 //   d1 = |P - H|, d2 = |A - P|, phi* = angle(P - H, A - P)
