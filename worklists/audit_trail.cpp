@@ -160,6 +160,25 @@ void open_audit_trail(Database& database, const std::filesystem::path& study_dir
   }
 }
 
+void insert_audit_row(Database& database, const AuditRow& row) {
+  database
+      .prepare(std::string("INSERT INTO audit(") + kColumns +
+               ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
+      .bind_int64(1, row.seq)
+      .bind_text(2, row.time)
+      .bind_text(3, row.operator_name)
+      .bind_text(4, row.task_id)
+      .bind_text(5, row.action)
+      .bind_text(6, row.before_json)
+      .bind_text(7, row.after_json)
+      .bind_text(8, row.reason)
+      .bind_text(9, row.mmm_version)
+      .bind_text(10, row.images_json)
+      .bind_text(11, row.prev_hash)
+      .bind_text(12, row.hash)
+      .step();
+}
+
 AuditEntry append_audit_entry(Database& database, AuditEntry entry) {
   if (!in_transaction(database)) {
     throw std::logic_error(database.path().string() +
@@ -183,22 +202,7 @@ AuditEntry append_audit_entry(Database& database, AuditEntry entry) {
   row.images_json = json_text(entry.images, "images");
   row.hash = audit_row_hash(row);
 
-  database
-      .prepare(std::string("INSERT INTO audit(") + kColumns +
-               ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
-      .bind_int64(1, row.seq)
-      .bind_text(2, row.time)
-      .bind_text(3, row.operator_name)
-      .bind_text(4, row.task_id)
-      .bind_text(5, row.action)
-      .bind_text(6, row.before_json)
-      .bind_text(7, row.after_json)
-      .bind_text(8, row.reason)
-      .bind_text(9, row.mmm_version)
-      .bind_text(10, row.images_json)
-      .bind_text(11, row.prev_hash)
-      .bind_text(12, row.hash)
-      .step();
+  insert_audit_row(database, row);
   database.prepare("INSERT OR REPLACE INTO meta(key, value) VALUES ('audit_head', ?)")
       .bind_text(1, head_json({row.seq, row.hash}))
       .step();

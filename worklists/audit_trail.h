@@ -129,6 +129,10 @@ std::vector<AuditEntry> read_audit(Database& database);
 // whatever the columns hold).
 std::vector<AuditRow> read_audit_rows(Database& database);
 
+// Writes `row` exactly as given (no hashing, no head update): the raw insert
+// append_audit_entry uses, and what tests use to forge rows.
+void insert_audit_row(Database& database, const AuditRow& row);
+
 // Seq and hash of the last row.
 AuditHead audit_database_head(Database& database);
 

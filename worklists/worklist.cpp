@@ -52,9 +52,6 @@ std::string patient_of(workflow::Database& database, const fs::path& dir) {
       database.prepare("SELECT given FROM inputs WHERE name = 'patient' AND is_file = 0");
   if (select.step()) {
     std::string given = select.column_text(0);
-    if (given.size() >= 2 && given.front() == '"' && given.back() == '"') {
-      given = given.substr(1, given.size() - 2);
-    }
     if (!given.empty()) return given;
   }
   return dir.filename().string();

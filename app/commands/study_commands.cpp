@@ -14,9 +14,8 @@
 #include "mmm_git_revision.h"
 #include "workflow/run/progress_display.h"
 #include "workflow/run/run_study.h"
-#include "workflow/store/study_lock.h"
 #include "workflow/study/study.h"
-#include "worklists/task_actions.h"
+#include "worklists/study_runner.h"
 
 namespace mmm::app {
 namespace {
@@ -129,16 +128,6 @@ void print_summary(const workflow::RunSummary& summary, const std::string& dir) 
 
 void run_run(const RunArgs& args, const workflow::NodeRegistry& registry) {
   workflow::Study study = workflow::Study::open(args.dir, registry);
-  std::optional<workflow::StudyLock> lock;
-  try {
-    lock.emplace(workflow::StudyLock::acquire(
-        study.dir(), std::chrono::milliseconds(static_cast<long>(args.wait_seconds * 1000))));
-  } catch (const workflow::StudyLockedError& e) {
-    std::cerr << "mmm: " << e.what()
-              << "\nhint: wait for it to finish, or run with --wait SECONDS to wait for it\n";
-    set_exit_code(kExitLocked);
-    return;
-  }
   const bool terminal = ::isatty(STDERR_FILENO) == 1 && !args.quiet;
   std::unique_ptr<workflow::RunObserver> display = workflow::make_progress_display(
       std::cerr, {.terminal = terminal, .show_cached = args.show_cached});
@@ -146,12 +135,17 @@ void run_run(const RunArgs& args, const workflow::NodeRegistry& registry) {
   options.jobs = args.jobs;
   options.provenance = this_program();
   options.observer = args.quiet ? nullptr : display.get();
-  worklists::prepare_worklist_tables(study);
-  const workflow::RunSummary summary = workflow::run_study(study, *lock, options);
-  const std::vector<worklists::Task> opened =
-      worklists::open_waiting_tasks(study, {worklists::kSystemOperator, MMM_VERSION});
+  const worklists::StudyRunResult result = worklists::run_study_with_tasks(
+      study, options, std::chrono::milliseconds(static_cast<long>(args.wait_seconds * 1000)));
+  if (result.locked) {
+    std::cerr << "mmm: " << result.lock_holder
+              << "\nhint: wait for it to finish, or run with --wait SECONDS to wait for it\n";
+    set_exit_code(kExitLocked);
+    return;
+  }
+  const workflow::RunSummary& summary = *result.summary;
   print_summary(summary, args.dir);
-  for (const worklists::Task& task : opened) {
+  for (const worklists::Task& task : result.opened) {
     std::cout << "task " << task.id << " opened for node '" << task.node
               << "': see 'mmm worklist', 'mmm task show " << task.id << "'\n";
   }

@@ -57,23 +57,7 @@ struct Trail {
     if (rehash) row.hash = audit_row_hash(row);
     db.exec("DROP TRIGGER IF EXISTS audit_no_update; DROP TRIGGER IF EXISTS audit_no_delete");
     db.prepare("DELETE FROM audit WHERE seq = ?").bind_int64(1, row.seq).step();
-    db.prepare(
-          "INSERT INTO audit(seq, time, operator_name, task_id, action, before_json, after_json, "
-          "reason, mmm_version, images_json, prev_hash, hash) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, "
-          "?, ?, ?)")
-        .bind_int64(1, row.seq)
-        .bind_text(2, row.time)
-        .bind_text(3, row.operator_name)
-        .bind_text(4, row.task_id)
-        .bind_text(5, row.action)
-        .bind_text(6, row.before_json)
-        .bind_text(7, row.after_json)
-        .bind_text(8, row.reason)
-        .bind_text(9, row.mmm_version)
-        .bind_text(10, row.images_json)
-        .bind_text(11, row.prev_hash)
-        .bind_text(12, row.hash)
-        .step();
+    insert_audit_row(db, row);
   }
 
   void set_meta_head(std::int64_t seq, const std::string& hash) {
