@@ -4,6 +4,7 @@ variation), the throughput and the per-item time. Prints the table and writes
 the same figures as JSON."""
 
 import json
+import os
 import sys
 
 
@@ -42,9 +43,18 @@ def main(suite, raw_path, out_path, build_type="unknown"):
         per_item = f"{r['ns_per_item']:.1f}" if "ns_per_item" in r else "-"
         print(f"{r['benchmark']:<24} {r['median_time']:>9.3f} {r['unit']:<2} "
               f"{r.get('cv_percent', 0):>6.1f} {items:>14} {per_item:>10}")
+    document = {"suite": suite, "build_type": build_type, "context": context,
+                "results": table}
+    # Suites that also measure accuracy (e.g. scaling) leave SUITE.accuracy.txt
+    # (the table people read) and SUITE.accuracy.json beside the raw output.
+    base = os.path.join(os.path.dirname(raw_path), suite)
+    if os.path.exists(base + ".accuracy.json"):
+        with open(base + ".accuracy.json", encoding="utf-8") as f:
+            document["accuracy"] = json.load(f)
+        with open(base + ".accuracy.txt", encoding="utf-8") as f:
+            print(f.read())
     with open(out_path, "w", encoding="utf-8") as f:
-        json.dump({"suite": suite, "build_type": build_type, "context": context,
-                   "results": table}, f, indent=2)
+        json.dump(document, f, indent=2)
     print(f"written {out_path}")
 
 

@@ -114,7 +114,7 @@ NeckWarp neck_warp_for(const Atlas& atlas, const Bone& root) {
     if (distal == nullptr) continue;
     warp.bone = joint.child;
     warp.head = joint.child_frame.translation();
-    warp.distal = (distal->parent_frame.translation() - warp.head).normalized();
+    warp.distal = (distal->child_frame.translation() - warp.head).normalized();
     // Lateral: away from the root's mid-plane, across the bone.
     const double side = warp.head.x() >= root.frame.translation().x() ? 1.0 : -1.0;
     Eigen::Vector3d lateral = side * Eigen::Vector3d::UnitX();
@@ -180,7 +180,7 @@ PatientDeformation make_patient_deformation(const Atlas& atlas, const PatientOpt
       int distal_count = 0;
       for (const Joint& child : atlas.joints) {
         if (child.parent == bone->name && child.type != JointType::kWeld) {
-          distal += child.parent_frame.translation();
+          distal += child.child_frame.translation();
           ++distal_count;
         }
       }
@@ -251,9 +251,6 @@ Atlas deform_atlas(const Atlas& atlas, const PatientDeformation& deformation) {
   for (Marker& marker : patient.markers) {
     marker.position = deformation.map_on_bone(marker.bone, marker.position);
   }
-  patient.provenance.push_back("synthetic patient: seed " +
-                               std::to_string(deformation.factors.seed) + ", height " +
-                               std::to_string(deformation.factors.height_mm) + " mm");
   return patient;
 }
 

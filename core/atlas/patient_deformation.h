@@ -5,7 +5,10 @@
 // Each bone gets an affine map anchored at its proximal joint centre:
 //   map_b(x) = c'_b + s * (I + (l_b - 1) a a^T + (w_b - 1) (I - a a^T)) (x - c_b)
 // with c_b the centre of the joint attaching b to its parent, a the unit
-// axis from c_b to the centre of b's distal joint (its long axis), s the
+// axis from c_b to the centre of b's distal joint (its long axis; joint
+// centres are the joints' child frames at rest: gait2392 puts the knee's
+// parent frame at the femur's origin and moves the knee by its coupled
+// translations, so the parent frames would give the femur no axis), s the
 // global scale (stature), l_b the segment-length factor and w_b the width
 // factor. c'_b = map_parent(c_b) keeps the chain connected. The root (the
 // pelvis) scales about its frame origin, its width (x, mediolateral) by the

@@ -1,0 +1,387 @@
+// Atlas scaling (issue 6): accuracy over synthetic patients against their
+// ground truth, beside the uniform-scaling baseline; the real-data check
+// against OpenSim's scale factors for subject01; and the speed of scaling
+// the whole default atlas (Google Benchmark, medians over repetitions).
+//
+// The atlas: $MMM_BENCH_ATLAS (bench/run builds the default one when
+// missing). The accuracy table goes to stdout and, as JSON, to
+// $MMM_BENCH_OUT_DIR/scaling.accuracy.json, which bench/table.py folds into
+// build/bench/scaling.json.
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/atlas/atlas_io.h"
+#include "core/atlas/atlas_meshes.h"
+#include "core/atlas/patient_deformation.h"
+#include "core/landmarks/static_trial_landmarks.h"
+#include "core/mesh/mass_properties.h"
+#include "core/mesh/surface_distance.h"
+#include "core/opensim/osim_model.h"
+#include "core/opensim/trc.h"
+#include "core/parallel_for.h"
+#include "core/scaling/atlas_scaling.h"
+
+namespace {
+
+using mmm::atlas::AtlasMeshes;
+using mmm::landmarks::LandmarkSet;
+namespace scaling = mmm::scaling;
+
+std::filesystem::path atlas_dir() {
+  const char* dir = std::getenv("MMM_BENCH_ATLAS");
+  return dir != nullptr ? dir : "build/atlas/vhf_right_leg";
+}
+
+struct Loaded {
+  mmm::atlas::Atlas atlas;
+  AtlasMeshes meshes;
+  std::shared_ptr<const scaling::PreparedAtlas> prepared;
+};
+
+const Loaded& loaded() {
+  static const Loaded data = [] {
+    Loaded l;
+    l.atlas = mmm::atlas::read_atlas(atlas_dir());
+    l.meshes = mmm::atlas::read_atlas_meshes(l.atlas, atlas_dir());
+    l.prepared = scaling::prepare_atlas(l.atlas, l.meshes);
+    return l;
+  }();
+  return data;
+}
+
+// The station's three landmarks, and the station's plus the bony landmarks
+// a markup import could add.
+const std::vector<std::string> kStation = {"femoral_head_centre_r", "patella_centre_r",
+                                           "ankle_centre_r"};
+const std::vector<std::string> kBony = {"asis_r",          "asis_l",
+                                        "sacral_point",    "lateral_epicondyle_r",
+                                        "medial_epicondyle_r", "lateral_malleolus_r",
+                                        "medial_malleolus_r",  "heel_r"};
+
+LandmarkSet landmark_set(const mmm::atlas::Atlas& truth, const std::vector<std::string>& names) {
+  LandmarkSet set;
+  set.source = "synthetic ground truth";
+  for (const std::string& name : names) {
+    const mmm::atlas::Landmark* landmark = truth.find_landmark(name);
+    if (landmark != nullptr) set.landmarks.push_back({name, landmark->position, {}, {}});
+  }
+  return set;
+}
+
+struct Truth {
+  mmm::atlas::Atlas atlas;
+  AtlasMeshes meshes;  // full levels only
+};
+
+Truth make_truth(const Loaded& l, std::uint64_t seed, double height_mm) {
+  mmm::atlas::PatientOptions options;
+  options.seed = seed;
+  options.height_mm = height_mm;
+  const mmm::atlas::PatientDeformation deformation =
+      mmm::atlas::make_patient_deformation(l.atlas, options);
+  Truth truth;
+  truth.atlas = mmm::atlas::deform_atlas(l.atlas, deformation);
+  std::map<std::string, mmm::mesh::IndexedMesh> blend;
+  for (const mmm::atlas::Bone& bone : l.atlas.bones) {
+    blend[bone.name] = l.meshes.at(bone.name).at(bone.meshes.back().level);
+    truth.meshes[bone.name]["full"] =
+        mmm::atlas::deform_bone_mesh(deformation, bone.name, l.meshes.at(bone.name).at("full"));
+  }
+  std::vector<mmm::mesh::IndexedMesh> muscles(l.atlas.muscles.size());
+  mmm::parallel_for(muscles.size(), 2, [&](std::size_t m) {
+    muscles[m] = mmm::atlas::deform_muscle_mesh(
+        deformation, blend, l.meshes.at(l.atlas.muscles[m].name).at("full"),
+        options.blend_radius_mm);
+  });
+  for (std::size_t m = 0; m < muscles.size(); ++m) {
+    truth.meshes[l.atlas.muscles[m].name]["full"] = std::move(muscles[m]);
+  }
+  return truth;
+}
+
+// The uniform baseline: one similarity for everything.
+AtlasMeshes uniform_meshes(const Loaded& l, const scaling::ScalingEstimate& estimate) {
+  AtlasMeshes out;
+  const Eigen::Affine3d& map = estimate.deformation.bone_maps.begin()->second;
+  for (const auto& [element, levels] : l.meshes) {
+    mmm::mesh::IndexedMesh mapped = levels.at("full");
+    mapped.V = (mapped.V * map.linear().transpose()).rowwise() + map.translation().transpose();
+    out[element]["full"] = std::move(mapped);
+  }
+  return out;
+}
+
+struct Accuracy {
+  double bone_mean_mm = 0;   // area-weighted over every bone surface
+  double bone_worst_p95_mm = 0;
+  double muscle_mean_mm = 0;  // area-weighted over every muscle surface
+  double muscle_worst_p95_mm = 0;
+  double landmark_max_mm = 0;
+  double volume_max_percent = 0;  // largest |scaled / true volume - 1|, over muscles
+  double penetration_max_mm = 0;  // new penetration (ours only; band vertices)
+  std::map<std::string, double> per_bone_mean_mm;
+};
+
+Accuracy measure(const Loaded& l, const Truth& truth, const AtlasMeshes& scaled,
+                 const LandmarkSet& set, const std::map<std::string, double>& residuals) {
+  Accuracy a;
+  std::vector<std::string> elements;
+  for (const auto& bone : l.atlas.bones) elements.push_back(bone.name);
+  for (const auto& muscle : l.atlas.muscles) elements.push_back(muscle.name);
+  std::vector<mmm::mesh::SurfaceDistance> distance(elements.size());
+  mmm::parallel_for(elements.size(), 2, [&](std::size_t e) {
+    distance[e] = mmm::mesh::surface_distance(scaled.at(elements[e]).at("full"),
+                                              truth.meshes.at(elements[e]).at("full"));
+  });
+  double bone_area = 0;
+  double muscle_area = 0;
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    const bool is_bone = e < l.atlas.bones.size();
+    const double area = mmm::mesh::surface_area(truth.meshes.at(elements[e]).at("full"));
+    if (is_bone) {
+      a.bone_mean_mm += area * distance[e].mean_mm;
+      bone_area += area;
+      a.bone_worst_p95_mm = std::max(a.bone_worst_p95_mm, distance[e].p95_mm);
+      a.per_bone_mean_mm[elements[e]] = distance[e].mean_mm;
+    } else {
+      a.muscle_mean_mm += area * distance[e].mean_mm;
+      muscle_area += area;
+      a.muscle_worst_p95_mm = std::max(a.muscle_worst_p95_mm, distance[e].p95_mm);
+      const double ratio = mmm::mesh::signed_volume(scaled.at(elements[e]).at("full")) /
+                           mmm::mesh::signed_volume(truth.meshes.at(elements[e]).at("full"));
+      a.volume_max_percent = std::max(a.volume_max_percent, 100.0 * std::abs(ratio - 1.0));
+    }
+  }
+  a.bone_mean_mm /= bone_area;
+  a.muscle_mean_mm /= muscle_area;
+  for (const auto& landmark : set.landmarks) {
+    const auto found = residuals.find(landmark.name);
+    if (found != residuals.end()) a.landmark_max_mm = std::max(a.landmark_max_mm, found->second);
+  }
+  return a;
+}
+
+nlohmann::json to_json(const Accuracy& a) {
+  return {{"bone_mean_mm", a.bone_mean_mm},       {"bone_worst_p95_mm", a.bone_worst_p95_mm},
+          {"muscle_mean_mm", a.muscle_mean_mm},   {"muscle_worst_p95_mm", a.muscle_worst_p95_mm},
+          {"landmark_max_mm", a.landmark_max_mm}, {"volume_max_percent", a.volume_max_percent},
+          {"penetration_max_mm", a.penetration_max_mm}, {"per_bone_mean_mm", a.per_bone_mean_mm}};
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// gait2392's femur (hip to knee centre at full extension) and tibia (knee
+// to ankle centre) lengths in mm.
+std::pair<double, double> gait2392_segment_lengths(const mmm::opensim::OsimModel& model) {
+  const mmm::opensim::Joint* hip = model.find_joint("hip_r");
+  const mmm::opensim::Joint* knee = model.find_joint("knee_r");
+  const mmm::opensim::Joint* ankle = model.find_joint("ankle_r");
+  if (hip == nullptr || knee == nullptr || ankle == nullptr) return {0.0, 0.0};
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  for (const mmm::opensim::TransformAxis& axis : knee->spatial_transform) {
+    if (axis.name.starts_with("translation")) shift += axis.axis * axis.function.evaluate(0.0);
+  }
+  const Eigen::Vector3d knee_in_femur = knee->parent.to_body(shift);
+  const Eigen::Vector3d hip_in_femur = hip->child.to_body(Eigen::Vector3d::Zero());
+  const Eigen::Vector3d knee_in_tibia = knee->child.to_body(Eigen::Vector3d::Zero());
+  const Eigen::Vector3d ankle_in_tibia = ankle->parent.to_body(Eigen::Vector3d::Zero());
+  return {1000.0 * (knee_in_femur - hip_in_femur).norm(),
+          1000.0 * (ankle_in_tibia - knee_in_tibia).norm()};
+}
+
+nlohmann::json real_data_check(std::ostream& out) {
+  const std::filesystem::path data = MMM_DATA_DIR;
+  const auto pipelines = data / "gait2392" / "Pipelines";
+  const auto result = mmm::landmarks::landmarks_from_static_trial(
+      mmm::opensim::read_trc(pipelines / "subject01_static.trc"));
+  const auto [femur_mm, tibia_mm] =
+      gait2392_segment_lengths(mmm::opensim::read_osim(data / "gait2392" /
+                                                       "gait2392_thelen2003muscle.osim"));
+  const auto at = [&](const char* name) { return result.landmarks.find(name)->position_mm; };
+  const double thigh = (at("knee_centre_r") - at("femoral_head_centre_r")).norm();
+  const double shank = (at("ankle_centre_r") - at("knee_centre_r")).norm();
+  const double femur = thigh / femur_mm;
+  const double tibia = shank / tibia_mm;
+  char line[256];
+  out << "\nreal data: subject01_static.trc landmarks vs OpenSim's scale set (gait2392 generic)\n";
+  std::snprintf(line, sizeof line, "  femur_r: hip-knee %.1f mm / generic %.1f mm = %.3f (OpenSim 1.147, %+.1f%%)\n",
+                thigh, femur_mm, femur, 100.0 * (femur / 1.14724 - 1.0));
+  out << line;
+  std::snprintf(line, sizeof line, "  tibia_r: knee-ankle %.1f mm / generic %.1f mm = %.3f (OpenSim 0.989, %+.1f%%)\n",
+                shank, tibia_mm, tibia, 100.0 * (tibia / 0.988523 - 1.0));
+  out << line;
+  return {{"femur_r", {{"ours", femur}, {"opensim", 1.14724}, {"thigh_mm", thigh}}},
+          {"tibia_r", {{"ours", tibia}, {"opensim", 0.988523}, {"shank_mm", shank}}}};
+}
+
+void accuracy_table(std::ostream& out) {
+  const Loaded& l = loaded();
+  const int patients = std::getenv("MMM_BENCH_PATIENTS") != nullptr
+                           ? std::atoi(std::getenv("MMM_BENCH_PATIENTS"))
+                           : 10;
+  std::vector<std::string> with_bony = kStation;
+  with_bony.insert(with_bony.end(), kBony.begin(), kBony.end());
+  const std::vector<std::string> methods = {"ours: station (H,P,A)", "ours: station + 8 bony",
+                                            "uniform baseline (H,P,A)"};
+  std::map<std::string, std::vector<Accuracy>> results;
+  nlohmann::json per_patient = nlohmann::json::array();
+  for (int p = 0; p < patients; ++p) {
+    const std::uint64_t seed = 101 + static_cast<std::uint64_t>(p);
+    const double height = 1500.0 + 550.0 * p / std::max(1, patients - 1);
+    const Truth truth = make_truth(l, seed, height);
+    nlohmann::json row = {{"seed", seed}, {"height_mm", height}};
+    std::map<std::string, double> last_residuals;
+    nlohmann::json last_report;
+    for (const std::string& method : methods) {
+      const bool bony = method == methods[1];
+      const LandmarkSet set = landmark_set(truth.atlas, bony ? with_bony : kStation);
+      Accuracy a;
+      if (method == methods[2]) {
+        const scaling::ScalingEstimate estimate = scaling::estimate_uniform_scaling(l.atlas, set);
+        a = measure(l, truth, uniform_meshes(l, estimate), set, estimate.landmark_residual_mm);
+      } else {
+        const scaling::ScaledAtlas scaled = scaling::scale_atlas(*l.prepared, set);
+        a = measure(l, truth, scaled.meshes, set, scaled.landmark_residual_mm);
+        last_residuals = scaled.landmark_residual_mm;
+        last_report = scaling::scaling_report_json(scaled);
+        for (const auto& muscle : scaled.muscles) {
+          a.penetration_max_mm =
+              std::max(a.penetration_max_mm, muscle.solution.excess_depth_after_mm);
+        }
+      }
+      row[method] = to_json(a);
+      if (method != methods[2]) row[method]["landmark_residual_mm"] = last_residuals;
+      results[method].push_back(a);
+    }
+    if (p == 0) row["report_of_ours_with_bony_landmarks"] = last_report;
+    per_patient.push_back(row);
+    std::cerr << "patient " << p + 1 << "/" << patients << " done\n";
+  }
+  const auto column = [&](const std::string& method, double Accuracy::*field, bool worst) {
+    std::vector<double> values;
+    for (const Accuracy& a : results[method]) values.push_back(a.*field);
+    return worst ? *std::max_element(values.begin(), values.end()) : median(values);
+  };
+  struct Row {
+    const char* label;
+    double Accuracy::*field;
+    const char* target;
+  };
+  const std::vector<Row> rows = {
+      {"landmark residual, max (mm)", &Accuracy::landmark_max_mm, "<= 0.5"},
+      {"bone surface mean (mm)", &Accuracy::bone_mean_mm, "<= 1.5"},
+      {"bone worst p95 (mm)", &Accuracy::bone_worst_p95_mm, ""},
+      {"muscle surface mean (mm)", &Accuracy::muscle_mean_mm, "<= 2"},
+      {"muscle worst p95 (mm)", &Accuracy::muscle_worst_p95_mm, ""},
+      {"muscle volume vs truth, max |%|", &Accuracy::volume_max_percent, ""},
+      {"new penetration, max (mm)", &Accuracy::penetration_max_mm, "<= 0.5"}};
+  char line[512];
+  out << "\nscaling accuracy over " << patients
+      << " synthetic patients (seeds 101.., statures 1500-2050 mm), exact landmarks;\n"
+      << "each cell: median over patients / worst patient\n";
+  std::snprintf(line, sizeof line, "%-34s %-22s %-22s %-24s %s\n", "metric", methods[0].c_str(),
+                methods[1].c_str(), methods[2].c_str(), "target");
+  out << line;
+  nlohmann::json table = nlohmann::json::array();
+  for (const Row& row : rows) {
+    std::string cells[3];
+    nlohmann::json entry = {{"metric", row.label}, {"target", row.target}};
+    for (int m = 0; m < 3; ++m) {
+      const double med = column(methods[static_cast<std::size_t>(m)], row.field, false);
+      const double worst = column(methods[static_cast<std::size_t>(m)], row.field, true);
+      char cell[64];
+      std::snprintf(cell, sizeof cell, "%.3f / %.3f", med, worst);
+      cells[m] = cell;
+      entry[methods[static_cast<std::size_t>(m)]] = {{"median", med}, {"worst", worst}};
+    }
+    std::snprintf(line, sizeof line, "%-34s %-22s %-22s %-24s %s\n", row.label, cells[0].c_str(),
+                  cells[1].c_str(), cells[2].c_str(), row.target);
+    out << line;
+    table.push_back(entry);
+  }
+  // Per bone, ours with the station landmarks: where the error is.
+  out << "per-bone mean surface distance, ours (station), median over patients (mm):\n ";
+  for (const auto& bone : l.atlas.bones) {
+    std::vector<double> values;
+    for (const Accuracy& a : results[methods[0]]) values.push_back(a.per_bone_mean_mm.at(bone.name));
+    std::snprintf(line, sizeof line, " %s %.2f", bone.name.c_str(), median(values));
+    out << line;
+  }
+  out << "\n";
+  nlohmann::json document = {{"table", table}, {"patients", per_patient},
+                             {"prepare_seconds", l.prepared->prepare_seconds}};
+  document["real_data"] = real_data_check(out);
+  const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
+  std::ofstream file(std::filesystem::path(out_dir != nullptr ? out_dir : ".") /
+                     "scaling.accuracy.json");
+  file << document.dump(2) << "\n";
+}
+
+// The table on stdout and beside the JSON (scaling.accuracy.txt), which
+// bench/table.py prints above the speed table.
+void write_accuracy_table() {
+  std::ostringstream text;
+  accuracy_table(text);
+  std::cout << text.str();
+  const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
+  std::ofstream file(std::filesystem::path(out_dir != nullptr ? out_dir : ".") /
+                     "scaling.accuracy.txt");
+  file << text.str();
+}
+
+void BM_PrepareAtlas(benchmark::State& state) {
+  const Loaded& l = loaded();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(scaling::prepare_atlas(l.atlas, l.meshes));
+  }
+}
+BENCHMARK(BM_PrepareAtlas)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+void BM_ScaleWholeAtlas(benchmark::State& state) {
+  const Loaded& l = loaded();
+  const Truth truth = make_truth(l, 7, 1780.0);
+  const LandmarkSet set = landmark_set(truth.atlas, kStation);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(scaling::scale_atlas(*l.prepared, set));
+  }
+}
+BENCHMARK(BM_ScaleWholeAtlas)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+void BM_ScaleWholeAtlasBony(benchmark::State& state) {
+  const Loaded& l = loaded();
+  const Truth truth = make_truth(l, 7, 1780.0);
+  std::vector<std::string> names = kStation;
+  names.insert(names.end(), kBony.begin(), kBony.end());
+  const LandmarkSet set = landmark_set(truth.atlas, names);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(scaling::scale_atlas(*l.prepared, set));
+  }
+}
+BENCHMARK(BM_ScaleWholeAtlasBony)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (std::getenv("MMM_BENCH_SKIP_ACCURACY") == nullptr) write_accuracy_table();
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
