@@ -4,12 +4,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
 #include <random>
 #include <sstream>
 #include <system_error>
 #include <utility>
 
+#include "core/directory_bundle.h"
 #include "core/errors.h"
 #include "core/suggest.h"
 #include "workflow/definition/workflow_loader.h"
@@ -24,17 +26,71 @@ namespace {
 constexpr const char* kDatabaseFile = "study.db";
 constexpr const char* kWorkflowFile = "workflow.yaml";
 
+// Only an Atlas may be given as a folder: its value is a folder on disk,
+// stored as the folder's bundle (core/directory_bundle.h). A file given for
+// an Atlas is taken as an already-packed bundle.
+bool accepts_folder(PortType type) { return type == PortType::kAtlas; }
+
+// A cheap fingerprint of an input's origin on disk, to notice a change
+// without reading the content. A folder (an Atlas given unpacked) has the
+// total size of its files and the newest modification time of any file or
+// folder in it: editing a file moves its time, while adding, removing or
+// renaming one moves the time of the folder that holds it.
 struct FileStamp {
   std::int64_t size = 0;
   std::int64_t mtime_ns = 0;
+  bool is_directory = false;
 };
 
-std::optional<FileStamp> stamp_of(const std::filesystem::path& file) {
+std::int64_t mtime_ns_of(const struct stat& info) {
+  return static_cast<std::int64_t>(info.st_mtim.tv_sec) * 1'000'000'000 +
+         static_cast<std::int64_t>(info.st_mtim.tv_nsec);
+}
+
+// Links are followed (stat), as pack_directory() records a linked file's
+// target bytes; links to folders are not walked (packing refuses them).
+FileStamp directory_stamp(const std::filesystem::path& dir, const struct stat& dir_info) {
+  FileStamp stamp{0, mtime_ns_of(dir_info), true};
+  std::error_code error;
+  std::filesystem::recursive_directory_iterator entries(dir, error);
+  for (; !error && entries != std::filesystem::recursive_directory_iterator();
+       entries.increment(error)) {
+    struct stat info {};
+    if (::stat(entries->path().c_str(), &info) != 0) continue;  // dangling: packing reports it
+    if (S_ISREG(info.st_mode)) stamp.size += static_cast<std::int64_t>(info.st_size);
+    if (S_ISREG(info.st_mode) || S_ISDIR(info.st_mode)) {
+      stamp.mtime_ns = std::max(stamp.mtime_ns, mtime_ns_of(info));
+    }
+  }
+  if (error) throw IoError(dir, "cannot list the folder: " + error.message());
+  return stamp;
+}
+
+// The stamp of a regular file or a folder given for an input of type
+// `type`; std::nullopt when `origin` is neither (or does not exist). A folder
+// given where none is accepted is not walked (a mistyped "/" costs nothing):
+// its stamp only says that it is a folder.
+std::optional<FileStamp> stamp_of(const std::filesystem::path& origin, PortType type) {
   struct stat info {};
-  if (::stat(file.c_str(), &info) != 0 || !S_ISREG(info.st_mode)) return std::nullopt;
-  return FileStamp{static_cast<std::int64_t>(info.st_size),
-                   static_cast<std::int64_t>(info.st_mtim.tv_sec) * 1'000'000'000 +
-                       static_cast<std::int64_t>(info.st_mtim.tv_nsec)};
+  if (::stat(origin.c_str(), &info) != 0) return std::nullopt;
+  if (S_ISDIR(info.st_mode)) {
+    return accepts_folder(type) ? directory_stamp(origin, info) : FileStamp{0, 0, true};
+  }
+  if (!S_ISREG(info.st_mode)) return std::nullopt;
+  return FileStamp{static_cast<std::int64_t>(info.st_size), mtime_ns_of(info), false};
+}
+
+// What to write after --input NAME= in hints.
+std::string input_placeholder(PortType type) {
+  if (is_value_type(type)) return "VALUE";
+  return accepts_folder(type) ? "DIR" : "PATH";
+}
+
+// Stores the content of an input's origin: a file's bytes, or a folder's
+// bundle. Returns the artifact hash.
+std::string store_origin(ArtifactStore& artifacts, const std::filesystem::path& origin,
+                         const FileStamp& stamp) {
+  return stamp.is_directory ? artifacts.put(pack_directory(origin)) : artifacts.put_file(origin);
 }
 
 std::string diagnostics_text(const LoadResult& result) {
@@ -131,8 +187,8 @@ Study Study::create(const std::filesystem::path& dir, const CreateStudyOptions& 
   for (const StudyInput& input : workflow.inputs) {
     if (!options.inputs.contains(input.name) && !input.default_value) {
       problems.push_back("study input '" + input.name + "' (" + input.type_name +
-                         ") has no default: give it with --input " + input.name +
-                         (is_value_type(*input.type) ? "=VALUE" : "=PATH"));
+                         ") has no default: give it with --input " + input.name + "=" +
+                         input_placeholder(*input.type));
     }
   }
   if (!problems.empty()) {
@@ -243,18 +299,30 @@ StudyInputRecord Study::import_input(const StudyInput& declared, std::string_vie
     return record;
   }
   const std::filesystem::path origin = std::filesystem::absolute(text).lexically_normal();
-  const std::optional<FileStamp> stamp = stamp_of(origin);
+  const std::optional<FileStamp> stamp = stamp_of(origin, record.type);
+  const std::string hint = "; hint: give the path of the " +
+                           std::string(accepts_folder(record.type) ? "atlas folder (or of a "
+                                                                     "packed bundle file)"
+                                                                   : "file") +
+                           " with --input " + declared.name + "=" + input_placeholder(record.type);
   if (!stamp) {
-    throw IoError(origin, what +
-                              ": no such file (or not a regular file); hint: give the path "
-                              "of the file with --input " +
-                              declared.name + "=PATH");
+    throw IoError(origin,
+                  what +
+                      (accepts_folder(record.type) ? ": no such folder or file"
+                                                   : ": no such file (or not a regular file)") +
+                      hint);
   }
+  if (stamp->is_directory && !accepts_folder(record.type)) {
+    throw IoError(origin,
+                  what + ": is a folder, but only Atlas inputs may be given as a folder" + hint);
+  }
+  // A folder input is still "a file's content" for the record: its origin is
+  // re-checked by refresh_file_inputs() like a file's.
   record.is_file = true;
   record.given = origin.string();
   record.source_size = stamp->size;
   record.source_mtime_ns = stamp->mtime_ns;
-  record.hash = artifacts_.put_file(origin);
+  record.hash = store_origin(artifacts_, origin, *stamp);
   return record;
 }
 
@@ -295,13 +363,15 @@ std::vector<std::string> Study::refresh_file_inputs() {
   std::vector<std::string> changes;
   for (const auto& [name, record] : inputs()) {
     if (!record.is_file) continue;
-    const std::optional<FileStamp> stamp = stamp_of(record.given);
-    if (!stamp) continue;  // the origin is gone: keep using the stored copy
+    const std::optional<FileStamp> stamp = stamp_of(record.given, record.type);
+    // An origin that is gone, or became a folder where only a file will do,
+    // is not a change: keep using the stored copy.
+    if (!stamp || (stamp->is_directory && !accepts_folder(record.type))) continue;
     if (stamp->size == record.source_size && stamp->mtime_ns == record.source_mtime_ns) continue;
     StudyInputRecord updated = record;
     updated.source_size = stamp->size;
     updated.source_mtime_ns = stamp->mtime_ns;
-    updated.hash = artifacts_.put_file(record.given);
+    updated.hash = store_origin(artifacts_, record.given, *stamp);
     if (updated.hash != record.hash) {
       updated.updated_at = utc_now();
       changes.push_back("study input '" + name + "' changed: " + record.given +
