@@ -66,10 +66,24 @@ const Loaded& loaded() {
 // a markup import could add.
 const std::vector<std::string> kStation = {"femoral_head_centre_r", "patella_centre_r",
                                            "ankle_centre_r"};
-const std::vector<std::string> kBony = {"asis_r",          "asis_l",
-                                        "sacral_point",    "lateral_epicondyle_r",
-                                        "medial_epicondyle_r", "lateral_malleolus_r",
-                                        "medial_malleolus_r",  "heel_r"};
+// $MMM_BENCH_BONY (comma-separated) replaces the bony set, to study one
+// landmark's effect.
+std::vector<std::string> bony_landmarks() {
+  const char* given = std::getenv("MMM_BENCH_BONY");
+  if (given == nullptr) {
+    return {"asis_r",          "asis_l",         "sacral_point",        "lateral_epicondyle_r",
+            "medial_epicondyle_r", "lateral_malleolus_r", "medial_malleolus_r", "heel_r"};
+  }
+  std::vector<std::string> names;
+  std::string text = given;
+  for (std::size_t start = 0; start <= text.size();) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    if (comma > start) names.push_back(text.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return names;
+}
+const std::vector<std::string> kBony = bony_landmarks();
 
 LandmarkSet landmark_set(const mmm::atlas::Atlas& truth, const std::vector<std::string>& names) {
   LandmarkSet set;
@@ -238,7 +252,7 @@ void accuracy_table(std::ostream& out) {
                            : 10;
   std::vector<std::string> with_bony = kStation;
   with_bony.insert(with_bony.end(), kBony.begin(), kBony.end());
-  const std::vector<std::string> methods = {"ours: station (H,P,A)", "ours: station + 8 bony",
+  const std::vector<std::string> methods = {"ours: station (H,P,A)", "ours: station + bony",
                                             "uniform baseline (H,P,A)"};
   std::map<std::string, std::vector<Accuracy>> results;
   nlohmann::json per_patient = nlohmann::json::array();

@@ -35,31 +35,19 @@ AnchorBuilder::AnchorBuilder(const Eigen::MatrixX3d& vertices, int k)
     : grid_(vertices),
       spread_(rows_of(vertices, strided_rows(vertices.rows(), kSpreadCount))),
       spread_rows_(strided_rows(vertices.rows(), kSpreadCount)),
-      k_(std::max(4, k)) {
-  // Typical vertex spacing, from a few vertices' nearest neighbours.
-  std::vector<double> gaps;
-  for (const int row : strided_rows(vertices.rows(), 64)) {
-    const std::vector<int> two = grid_.nearest(vertices.row(row).transpose(), 2);
-    if (two.size() == 2) gaps.push_back((vertices.row(two[1]) - vertices.row(row)).norm());
-  }
-  if (!gaps.empty()) {
-    std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2),
-                     gaps.end());
-    spacing_mm_ = std::max(1e-6, gaps[gaps.size() / 2]);
-  }
-}
+      k_(std::max(4, k)) {}
 
 AffineAnchor AnchorBuilder::anchor(const Eigen::Vector3d& point) const {
   if (!point.allFinite()) throw InvalidInputError("affine anchor: the point is not finite");
   const Eigen::MatrixX3d& vertices = grid_.points();
+  // The nearest vertices, and the nearest of a subsample spread over the
+  // whole surface: near a surface the nearest form a nearly flat patch that
+  // fixes the direction off it badly, and the spread ones (weighted down by
+  // their distance) keep the system well conditioned there.
   std::vector<int> rows = grid_.nearest(point, k_);
-  // Far from the surface (more than a few vertex spacings) the nearest
-  // vertices form a flat patch that fixes the normal direction badly: take
-  // the nearest of a subsample spread over the whole surface instead.
-  const double gap = (vertices.row(rows.front()).transpose() - point).norm();
-  if (gap > 4.0 * spacing_mm_) {
-    rows = spread_.nearest(point, k_);
-    for (int& row : rows) row = spread_rows_[static_cast<std::size_t>(row)];
+  for (int row : spread_.nearest(point, k_)) {
+    row = spread_rows_[static_cast<std::size_t>(row)];
+    if (std::find(rows.begin(), rows.end(), row) == rows.end()) rows.push_back(row);
   }
   const auto k = static_cast<Eigen::Index>(rows.size());
   Eigen::MatrixXd B(4, k);
@@ -75,11 +63,22 @@ AffineAnchor AnchorBuilder::anchor(const Eigen::Vector3d& point) const {
   Eigen::VectorXd phi(k);
   const double h2 = std::max(mean_distance * mean_distance, 1e-12);
   for (Eigen::Index i = 0; i < k; ++i) phi[i] = 1.0 / (B.block<3, 1>(0, i).squaredNorm() + h2);
-  Eigen::Matrix4d normal = B * phi.asDiagonal() * B.transpose();
-  normal.diagonal().array() += 1e-12 * normal.trace();
-  Eigen::Vector4d target(0.0, 0.0, 0.0, 1.0);
-  const Eigen::Vector4d lambda = normal.ldlt().solve(target);
-  const Eigen::VectorXd w = phi.asDiagonal() * (B.transpose() * lambda);
+  const Eigen::Matrix4d normal = B * phi.asDiagonal() * B.transpose();
+  const Eigen::FullPivLU<Eigen::Matrix4d> lu(normal);
+  // Two steps of iterative refinement take the constraint to rounding.
+  const Eigen::Vector4d target(0.0, 0.0, 0.0, 1.0);
+  Eigen::VectorXd w = phi.asDiagonal() * (B.transpose() * lu.solve(target));
+  for (int step = 0; step < 2; ++step) {
+    const Eigen::Vector4d residual = target - B * w;
+    w += phi.asDiagonal() * (B.transpose() * lu.solve(residual));
+  }
+  // Coplanar vertices (a flat surface) cannot express a point off their
+  // plane: the constraint then fails.
+  if (!w.allFinite() || (target - B * w).norm() > 1e-6 * (1.0 + mean_distance)) {
+    throw InvalidInputError(
+        "affine anchor: the surface's vertices are degenerate (all in one plane?) and cannot "
+        "express the point");
+  }
   AffineAnchor anchor;
   anchor.vertices = std::move(rows);
   anchor.weights.assign(w.data(), w.data() + w.size());

@@ -9,14 +9,15 @@
 // the surface (the affine combination commutes with it), and for a smooth
 // non-affine deformation the point moves as the surface around it does.
 //
-// Weights: the k vertices nearest p (on the whole surface for points far
-// from it, whose nearest vertices would be a nearly flat patch, k from a
-// spread subsample), with the weighted minimum-norm solution
+// Weights: over the k vertices nearest p and the k nearest p of a subsample
+// spread over the whole surface (near the surface the nearest vertices form
+// a nearly flat patch, which alone would fix the direction off it badly),
+// the weighted minimum-norm solution
 //   min sum_i w_i^2 / phi_i  subject to  B w = (p, 1),  phi_i = 1 / (|v_i - p|^2 + h^2)
-// (B the 4 x k matrix of homogeneous vertex positions, h the mean distance
-// of the k vertices), i.e. w = Phi B^T (B Phi B^T)^-1 (p, 1): the nearest
-// vertices carry the most weight. A tiny ridge (1e-12 of the trace) keeps a
-// perfectly flat patch solvable; the constraint then holds to ~1e-9 mm.
+// (B the 4 x m matrix of homogeneous vertex positions, h the mean distance
+// of the m vertices), i.e. w = Phi B^T (B Phi B^T)^-1 (p, 1): the nearest
+// vertices carry the most weight; two steps of iterative refinement take the
+// constraint to rounding.
 
 #include <Eigen/Core>
 #include <vector>
@@ -30,9 +31,7 @@ struct AffineAnchor {
   std::vector<double> weights;  // sum to 1
 };
 
-// Builds anchors on one surface (its vertices `grid.points()`); `spread` is a
-// grid over a subsample spread over the same surface, with `spread_rows`
-// mapping its rows to the surface's vertex rows.
+// Builds anchors on one surface, given its vertices.
 class AnchorBuilder {
  public:
   explicit AnchorBuilder(const Eigen::MatrixX3d& vertices, int k = 16);
@@ -44,9 +43,8 @@ class AnchorBuilder {
 
  private:
   mesh::VertexGrid grid_;
-  mesh::VertexGrid spread_;
-  std::vector<int> spread_rows_;
-  double spacing_mm_ = 1.0;  // median distance to the nearest other vertex
+  mesh::VertexGrid spread_;        // over a subsample of the vertices
+  std::vector<int> spread_rows_;   // its rows -> vertex rows
   int k_ = 16;
 };
 

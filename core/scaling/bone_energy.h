@@ -39,8 +39,8 @@ namespace mmm::scaling {
 
 struct BoneEnergyOptions {
   double laplacian_weight = 1.0;        // w_L
-  double affine_prior_weight = 1e-4;    // w_p (per mm^2)
-  double gauge_weight = 1e-8;           // w_d, relative to the mean diagonal of w_L L^T L
+  double affine_prior_weight = 1e-8;    // w_p (per mm^2)
+  double gauge_weight = 1e-4;           // w_d, relative to the mean diagonal of w_L L^T L
   double closed_form_tolerance_mm = 1e-6;
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "core/errors.h"
 #include "core/mesh/aabb_tree.h"
@@ -20,9 +21,10 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 // cannot be in it on the full one.
 constexpr double kCoarseMarginMm = 8.0;
 
-// Depth now beyond depth at rest (mm, >= 0).
-double excess_depth(double signed_distance, double rest_signed_distance) {
-  return std::max(0.0, -signed_distance) - std::max(0.0, -rest_signed_distance);
+// Depth now beyond the depth at rest scaled with the bone (mm): an overlap
+// the atlas already has is not new, and grows with the bone like any length.
+double excess_depth(double signed_distance, double rest_signed_distance, double bone_scale) {
+  return std::max(0.0, -signed_distance) - bone_scale * std::max(0.0, -rest_signed_distance);
 }
 
 }  // namespace
@@ -55,7 +57,7 @@ PreparedMuscle prepare_muscle(const std::string& name, const mesh::IndexedMesh& 
       total += muscle.blend(i, b);
     }
     muscle.blend.row(i) /= total;
-    // The bone this vertex is nearest, on the full surfaces, when near any.
+    // Every bone this vertex is near, on the full surfaces; the nearest.
     double best = std::numeric_limits<double>::infinity();
     int best_bone = -1;
     for (Eigen::Index b = 0; b < bone_count; ++b) {
@@ -63,16 +65,16 @@ PreparedMuscle prepare_muscle(const std::string& name, const mesh::IndexedMesh& 
         continue;
       }
       const double sd = bones[static_cast<std::size_t>(b)].distance->at(p);
+      if (sd >= options.band_mm) continue;
+      muscle.band.push_back(static_cast<int>(i));
+      muscle.band_bone.push_back(static_cast<int>(b));
+      muscle.band_rest_distance.push_back(sd);
       if (sd < best) {
         best = sd;
         best_bone = static_cast<int>(b);
       }
     }
-    if (best_bone < 0 || best >= options.band_mm) continue;
-    muscle.band.push_back(static_cast<int>(i));
-    muscle.band_bone.push_back(best_bone);
-    muscle.band_rest_distance.push_back(best);
-    if (best <= options.contact_distance_mm) {
+    if (best_bone >= 0 && best <= options.contact_distance_mm) {
       muscle.attached.push_back(static_cast<int>(i));
       muscle.attached_bone.push_back(best_bone);
       muscle.attached_anchor.push_back(bones[static_cast<std::size_t>(best_bone)].anchors->anchor(p));
@@ -82,7 +84,11 @@ PreparedMuscle prepare_muscle(const std::string& name, const mesh::IndexedMesh& 
   const SparseMatrix L = mesh::cotangent_laplacian(surface.V, surface.F);
   SparseMatrix K = options.laplacian_weight * SparseMatrix(L.transpose() * L);
   VectorXd diagonal = VectorXd::Constant(n, options.gauge_weight * K.diagonal().mean());
-  for (const int i : muscle.band) diagonal[i] += options.band_weight;
+  std::vector<bool> in_band(static_cast<std::size_t>(n), false);
+  for (const int i : muscle.band) in_band[static_cast<std::size_t>(i)] = true;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (in_band[static_cast<std::size_t>(i)]) diagonal[i] += options.band_weight;
+  }
   for (const int i : muscle.attached) diagonal[i] += options.attachment_weight;
   K += SparseMatrix(diagonal.asDiagonal());
   muscle.factor = std::make_shared<Eigen::SimplicialLDLT<SparseMatrix>>(K);
@@ -112,7 +118,8 @@ MuscleSolution solve_muscle(const PreparedMuscle& muscle, const std::vector<Scal
   Eigen::MatrixX3d attached_rhs = Eigen::MatrixX3d::Zero(n, 3);
   MuscleSolution solution;
   solution.attached_vertices = static_cast<int>(muscle.attached.size());
-  solution.band_vertices = static_cast<int>(muscle.band.size());
+  solution.band_vertices = static_cast<int>(
+      std::set<int>(muscle.band.begin(), muscle.band.end()).size());
   double attached_sq = 0.0;
   for (std::size_t a = 0; a < muscle.attached.size(); ++a) {
     const int i = muscle.attached[a];
@@ -120,6 +127,10 @@ MuscleSolution solve_muscle(const PreparedMuscle& muscle, const std::vector<Scal
         muscle.attached_anchor[a],
         *bones[static_cast<std::size_t>(muscle.attached_bone[a])].vertices);
     attached_rhs.row(i) = options.attachment_weight * (target - start.row(i).transpose()).transpose();
+  }
+  std::vector<double> bone_scale;
+  for (const ScaledBone& bone : bones) {
+    bone_scale.push_back(std::cbrt(std::abs(bone.affine->linear().determinant())));
   }
   // Band targets, as offsets from X1 (0 until a vertex must be pushed out).
   Eigen::MatrixX3d band_offset = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(muscle.band.size()), 3);
@@ -140,7 +151,8 @@ MuscleSolution solve_muscle(const PreparedMuscle& muscle, const std::vector<Scal
           *bones[static_cast<std::size_t>(muscle.band_bone[k])].distance;
       const Vector3d x = solution.vertices.row(i).transpose();
       const double sd = bone.at(x);
-      const double excess = excess_depth(sd, muscle.band_rest_distance[k]);
+      const double excess =
+          excess_depth(sd, muscle.band_rest_distance[k], bone_scale[static_cast<std::size_t>(muscle.band_bone[k])]);
       if (excess <= options.penetration_tolerance_mm) continue;
       ++penetrating;
       worst = std::max(worst, excess);

@@ -18,9 +18,13 @@
 //                                             bone than it was at rest
 //        + w_d |u|^2                          gauge (tiny)
 // Non-penetration: after each solve the band vertices are tested against
-// the scaled bone they are near (signed distance); any deeper than at rest
-// (plus a tolerance) has its q_i moved out by its excess depth (+ a margin)
+// every scaled bone they were near at rest (signed distance); any deeper than at rest
+// (that depth scaled with the bone: the atlas's own overlaps are not new)
+// plus a tolerance has its q_i moved out by its excess depth (+ a margin)
 // along the direction to the bone surface, and the problem is solved again.
+// Only band vertices are tested: one farther than band_mm from every bone at
+// rest would need the blend to move it that much more than the bone under
+// it, far beyond the maps' differences near a joint in any human scaling.
 // Every term's weights and vertex sets depend on the atlas alone, so the
 // matrix w_L L^T L + W_a + W_b + w_d I is factored once per muscle in
 // prepare_muscle and every patient and iteration is back-substitutions.
@@ -44,7 +48,7 @@ struct MuscleEnergyOptions {
   double band_weight = 1.0;          // w_b (per mm^2)
   double gauge_weight = 1e-6;        // w_d, relative to the mean diagonal of w_L L^T L
   double contact_distance_mm = 1.5;  // attached: closer than this to a bone at rest
-  double band_mm = 6.0;              // band: closer than this to a bone at rest
+  double band_mm = 10.0;             // band: closer than this to a bone at rest
   double blend_radius_mm = 10.0;     // eps of the blend weights
   double penetration_tolerance_mm = 0.1;
   double penetration_margin_mm = 0.2;
@@ -69,6 +73,8 @@ struct PreparedMuscle {
   std::vector<int> attached;                // vertex rows
   std::vector<int> attached_bone;           // index into the bones
   std::vector<AffineAnchor> attached_anchor;
+  // Band: one entry per (vertex, bone) pair closer than band_mm at rest; a
+  // vertex near two bones is tested against both.
   std::vector<int> band;                    // vertex rows
   std::vector<int> band_bone;
   std::vector<double> band_rest_distance;  // signed distance at rest (mm; < 0 inside)
@@ -101,7 +107,7 @@ struct MuscleSolution {
   double excess_depth_after_mm = 0.0;
   double attachment_rms_mm = 0.0;  // |x_i - a_i| over attached vertices
   int attached_vertices = 0;
-  int band_vertices = 0;
+  int band_vertices = 0;  // distinct vertices in the band
 };
 
 MuscleSolution solve_muscle(const PreparedMuscle& muscle, const std::vector<ScaledBone>& bones,
