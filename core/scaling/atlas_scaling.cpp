@@ -320,6 +320,8 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
                                          terms, options.bone);
       report = describe_bone(a, *bone, solution.affine);
       report.solved = solution.solved;
+      report.bent = solution.bent;
+      report.free_directions = solution.free_directions;
       for (const PointTerm& term : terms) report.terms.push_back(term.name);
       report.term_residual_mm = solution.residual_mm;
       placed.affine[bone->name] = solution.affine;
@@ -403,8 +405,10 @@ nlohmann::json scaling_report_json(const ScaledAtlas& scaled) {
   for (const BoneScaling& bone : scaled.bones) {
     json entry = {{"bone", bone.bone},
                   {"solve", !bone.welded_to.empty() ? "welded to " + bone.welded_to
-                            : bone.solved           ? "sparse LDLT"
-                                                    : "closed form"},
+                            : bone.bent             ? "affine fit + Laplacian detail (sparse LDLT)"
+                            : bone.solved           ? "affine fit"
+                                                    : "first stage (meets every term)"},
+                  {"affine_directions_from_first_stage", bone.free_directions},
                   {"stretches", {bone.stretches.x(), bone.stretches.y(), bone.stretches.z()}},
                   {"volume_scale", bone.affine.linear().determinant()}};
     if (bone.length_factor > 0.0) entry["length_factor"] = bone.length_factor;

@@ -82,7 +82,9 @@ std::shared_ptr<const PreparedAtlas> prepare_atlas(atlas::Atlas atlas, atlas::At
 
 struct BoneScaling {
   std::string bone;
-  bool solved = false;            // false: closed form, or follows the bone it is welded to
+  bool solved = false;            // false: the first stage met every term, or welded
+  bool bent = false;              // the Laplacian detail step ran
+  int free_directions = 0;        // affine directions kept from the first stage
   std::string welded_to;          // non-empty for welded bones
   Eigen::Affine3d affine;         // affine part of its placement (atlas -> patient)
   double length_factor = 1.0;     // along its long axis (0 when it has none)

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <cmath>
 
 #include "core/errors.h"
@@ -57,68 +58,100 @@ BoneSolution solve_bone(const mesh::IndexedMesh& rest, const Eigen::Affine3d& pr
   const Eigen::Index n = rest.V.rows();
   const Vector3d c = rest.V.colwise().mean().transpose();
   const Eigen::MatrixX3d Y = rest.V.rowwise() - c.transpose();
+  const auto place = [&](const Eigen::Affine3d& map) {
+    return Eigen::MatrixX3d((Y * map.linear().transpose()).rowwise() + (map * c).transpose());
+  };
 
-  // Closed form: the prior already meets every term.
+  // The prior already meets every term: E(0, g0) = 0.
   solution.affine = prior;
-  solution.vertices = (Y * prior.linear().transpose()).rowwise() + (prior * c).transpose();
+  solution.vertices = place(prior);
   solution.residual_mm = residuals(terms, solution.vertices);
-  bool met = true;
-  for (const double r : solution.residual_mm) met = met && r <= options.closed_form_tolerance_mm;
-  if (met) return solution;
+  if (std::ranges::all_of(solution.residual_mm,
+                          [&](double r) { return r <= options.closed_form_tolerance_mm; })) {
+    return solution;
+  }
 
+  // 1. The affine part: the point terms' least squares, the prior filling
+  //    the directions they leave open.
   const double radius = std::sqrt(Y.rowwise().squaredNorm().mean());
-  const SparseMatrix L = mesh::cotangent_laplacian(rest.V, rest.F);
-  SparseMatrix K = options.laplacian_weight * SparseMatrix(L.transpose() * L);
-  const double gauge = options.gauge_weight * K.diagonal().mean();
-  // Point rows: A (anchors), P (homogeneous centred rest points), W (weights).
   const auto m = static_cast<Eigen::Index>(terms.size());
-  SparseMatrix A(m, n);
-  std::vector<Eigen::Triplet<double>> entries;
   MatrixXd P(m, 4);
   VectorXd w(m);
   Eigen::MatrixX3d targets(m, 3);
   for (Eigen::Index j = 0; j < m; ++j) {
     const PointTerm& term = terms[static_cast<std::size_t>(j)];
-    for (std::size_t i = 0; i < term.anchor.vertices.size(); ++i) {
-      entries.emplace_back(j, term.anchor.vertices[i], term.anchor.weights[i]);
-    }
     P.block<1, 3>(j, 0) = (term.rest - c).transpose();
     P(j, 3) = 1.0;
     w[j] = term.weight;
     targets.row(j) = term.target.transpose();
+  }
+  // In units of mm (h = D g, D = diag(R, R, R, 1)), the points' normal
+  // matrix; its eigenvectors with enough weight are fitted, the others keep
+  // the prior (a point pair 1 mm apart must not decide how the whole bone
+  // shears).
+  const Vector4d D(radius, radius, radius, 1.0);
+  const Matrix4d normal = D.cwiseInverse().asDiagonal() * (P.transpose() * w.asDiagonal() * P) *
+                          D.cwiseInverse().asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Matrix4d> eigen(normal);
+  const double largest = eigen.eigenvalues().maxCoeff();
+  Matrix4d fitted_inverse = Matrix4d::Zero();
+  solution.free_directions = 0;
+  for (int i = 0; i < 4; ++i) {
+    const double lambda = eigen.eigenvalues()[i];
+    if (lambda > options.determined_fraction * largest && lambda > 0.0) {
+      fitted_inverse += eigen.eigenvectors().col(i) * eigen.eigenvectors().col(i).transpose() / lambda;
+    } else {
+      ++solution.free_directions;
+    }
+  }
+  const Eigen::Matrix<double, 4, 3> g0 = centred_parameters(prior, c);
+  Eigen::Matrix<double, 4, 3> g;
+  for (int k = 0; k < 3; ++k) {
+    const VectorXd misfit = targets.col(k) - P * g0.col(k);
+    const Vector4d step = D.cwiseInverse().asDiagonal() *
+                          (fitted_inverse * (D.cwiseInverse().asDiagonal() *
+                                             (P.transpose() * (w.asDiagonal() * misfit))));
+    g.col(k) = g0.col(k) + step;
+  }
+  solution.affine = affine_from(g, c);
+  solution.vertices = place(solution.affine);
+  solution.residual_mm = residuals(terms, solution.vertices);
+  solution.solved = true;
+  if (std::ranges::all_of(solution.residual_mm,
+                          [&](double r) { return r <= options.closed_form_tolerance_mm; })) {
+    return solution;
+  }
+
+  // 2. The detail: what no affine map explains, as a smooth bend d with
+  //    the least change of the differential coordinates.
+  const SparseMatrix L = mesh::cotangent_laplacian(rest.V, rest.F);
+  SparseMatrix K = options.laplacian_weight * SparseMatrix(L.transpose() * L);
+  const double gauge = options.gauge_weight * K.diagonal().mean();
+  SparseMatrix A(m, n);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    const PointTerm& term = terms[static_cast<std::size_t>(j)];
+    for (std::size_t i = 0; i < term.anchor.vertices.size(); ++i) {
+      entries.emplace_back(j, term.anchor.vertices[i], term.anchor.weights[i]);
+    }
   }
   A.setFromTriplets(entries.begin(), entries.end());
   K += SparseMatrix(A.transpose() * w.asDiagonal() * A);
   SparseMatrix identity(n, n);
   identity.setIdentity();
   K += gauge * identity;
-  Eigen::SimplicialLDLT<SparseMatrix> factor(K);
+  const Eigen::SimplicialLDLT<SparseMatrix> factor(K);
   if (factor.info() != Eigen::Success) {
     throw SolverError("bone energy: the sparse LDLT factorisation of the detail term failed");
   }
-  const MatrixXd K_dg = A.transpose() * w.asDiagonal() * P;  // n x 4
-  const Vector4d D2(radius * radius, radius * radius, radius * radius, 1.0);
-  const Matrix4d K_gg = P.transpose() * w.asDiagonal() * P +
-                        Matrix4d(options.affine_prior_weight * D2.asDiagonal());
-  const MatrixXd Z = factor.solve(K_dg);  // K_dd^-1 K_dg
-  const Matrix4d S = K_gg - K_dg.transpose() * Z;
-  const Eigen::LDLT<Matrix4d> schur(S);
-  const Eigen::Matrix<double, 4, 3> g0 = centred_parameters(prior, c);
-  Eigen::Matrix<double, 4, 3> g;
+  const Eigen::MatrixX3d misfit = targets - A * solution.vertices;
   for (int k = 0; k < 3; ++k) {
-    const VectorXd b_d = A.transpose() * (w.asDiagonal() * targets.col(k));
-    const Vector4d b_g = P.transpose() * (w.asDiagonal() * targets.col(k)) +
-                         Vector4d(options.affine_prior_weight * D2.cwiseProduct(g0.col(k)));
-    const VectorXd e = factor.solve(b_d);
-    g.col(k) = schur.solve(b_g - K_dg.transpose() * e);
-    const VectorXd d = e - Z * g.col(k);
-    solution.vertices.col(k) = Y * g.col(k).head<3>() + VectorXd::Constant(n, g(3, k)) + d;
+    solution.vertices.col(k) += factor.solve(VectorXd(A.transpose() * (w.asDiagonal() * misfit.col(k))));
   }
   if (!solution.vertices.allFinite()) {
     throw SolverError("bone energy: the solution is not finite (degenerate point terms?)");
   }
-  solution.affine = affine_from(g, c);
-  solution.solved = true;
+  solution.bent = true;
   solution.residual_mm = residuals(terms, solution.vertices);
   return solution;
 }

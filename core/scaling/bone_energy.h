@@ -5,28 +5,30 @@
 // call for cost nothing and only non-affine bending is paid for.
 //
 // The surface is written x = M (v - c) + t + d: an affine part g = (M, t)
-// about the bone's centroid c, plus a detail displacement d per vertex. The
-// differential coordinates of the result are asked to be those of the affine
-// part (L x = L (V - c) M^T, i.e. L d = 0), so with L the cotangent Laplacian
-//   E(d, g) = w_L |L d|^2                                   detail
-//           + sum_j w_j |sum_i a_ji x_i - p_j|^2               point terms
-//           + w_p |D (g - g0)|^2                             affine prior
-//           + w_d |d|^2                                      gauge (tiny)
-// where point j is tied to the surface by an affine anchor a_j
-// (affine_anchor.h) and pulled to its target p_j (landmarks, joint centres
-// shared with the neighbouring bones), g0 is the first-stage estimate
-// (anatomical_scaling.h) and D = diag(R, R, R, 1) weighs the prior on M by
-// the bone's RMS radius R, so both parts of the prior are in mm. When the
-// point terms call for an affine map, the minimum is that map with d = 0
-// (exactly, up to the prior's pull of ~w_p R^2 / w_j); when they cannot all
-// be met by one affine map, d bends the surface smoothly around them.
-//
-// One linear least-squares problem per coordinate, all three sharing one
-// matrix: the normal equations in d are factored once (sparse LDLT) and the
-// four affine unknowns eliminated by their Schur complement (4 + 6 back
-// substitutions in all). When g0 already meets every point term within
-// `closed_form_tolerance_mm`, E(0, g0) = 0 is the minimum and nothing is
-// solved.
+// about the bone's centroid c, plus a detail displacement d per vertex.
+// Point j is tied to the surface by an affine anchor a_j (affine_anchor.h)
+// and pulled to its target p_j (landmarks, joint centres shared with the
+// neighbouring bones) with weight w_j. Solved in two steps, so that the
+// proportions the points call for cost nothing and only what no affine map
+// explains is paid for as bending:
+//  1. the affine part: least squares over the point terms, in the
+//     directions of the 12 affine parameters they determine; the others keep
+//     the first-stage estimate g0 (anatomical_scaling.h). In mm units (the
+//     parameters of M weighed by the bone's RMS radius R), a direction is
+//     determined when its eigenvalue of the points' normal matrix is at
+//     least `determined_fraction` of the largest: the points are spread
+//     along it by at least ~sqrt(fraction) R. So three landmarks fix the
+//     9 parameters their plane allows and g0 fills the rest, and a pair of
+//     points 1 mm apart (a landmark beside a joint centre) does not decide
+//     how the whole bone shears. Exact for points an affine map explains;
+//  2. the detail, when points are still missed: Laplacian detail
+//     preservation (Sorkine 2006) of the affinely placed surface with the
+//     point terms on the rest,
+//       min w_L |L d|^2 + sum_j w_j |a_j . (x_affine + d) - p_j|^2 + w_d |d|^2,
+//     L the cotangent Laplacian, w_d a tiny gauge: a smooth bend, one
+//     sparse LDLT factorisation shared by the three coordinates.
+// When g0 already meets every point term within closed_form_tolerance_mm
+// nothing is solved (E = 0 there); when the affine fit meets them, no bend.
 
 #include <Eigen/Geometry>
 #include <string>
@@ -39,7 +41,7 @@ namespace mmm::scaling {
 
 struct BoneEnergyOptions {
   double laplacian_weight = 1.0;        // w_L
-  double affine_prior_weight = 1e-8;    // w_p (per mm^2)
+  double determined_fraction = 1e-3;    // see step 1
   double gauge_weight = 1e-4;           // w_d, relative to the mean diagonal of w_L L^T L
   double closed_form_tolerance_mm = 1e-6;
 };
@@ -56,6 +58,8 @@ struct BoneSolution {
   Eigen::MatrixX3d vertices;  // the placed surface
   Eigen::Affine3d affine;     // its affine part g, as a map of atlas points
   bool solved = false;        // false: closed form (g0 met every term)
+  bool bent = false;          // true: step 2 ran (no affine map met every term)
+  int free_directions = 0;    // affine parameter directions kept from g0 (of 4 per coordinate)
   // Per point term: |reconstructed point - target| (mm), in the given order.
   std::vector<double> residual_mm;
 };

@@ -83,16 +83,39 @@ std::vector<PointTerm> terms_for(const mesh::IndexedMesh& bone, const std::vecto
 TEST(BoneEnergyTest, AKnownAffineMapIsRecoveredExactly) {
   const mesh::IndexedMesh bone = ellipsoid(Vector3d(0, 0, -200), Vector3d(25, 20, 200));
   const Affine3d truth = skewed_affine();
-  // Four non-coplanar landmarks (two on the surface, one inside, one off it).
+  // Five landmarks around the bone, spread in every direction (on, inside
+  // and off the surface).
   const std::vector<PointTerm> terms =
-      terms_for(bone, {Vector3d(bone.V.row(3).transpose()), Vector3d(bone.V.row(500).transpose()),
-                       Vector3d(0, 0, -350), Vector3d(40, 10, -20)},
+      terms_for(bone,
+                {Vector3d(25, 0, -200), Vector3d(0, 20, -120), Vector3d(-30, 0, -280),
+                 Vector3d(0, -15, -50), Vector3d(0, 0, -390)},
                 truth);
   const BoneSolution solution = solve_bone(bone, Affine3d::Identity(), terms);
   EXPECT_TRUE(solution.solved);
+  EXPECT_EQ(solution.free_directions, 0);
+  EXPECT_FALSE(solution.bent);
   EXPECT_LT((solution.vertices - mapped(truth, bone.V)).rowwise().norm().maxCoeff(), 1e-4);
   EXPECT_LT((solution.affine.linear() - truth.linear()).norm(), 1e-5);
   for (const double r : solution.residual_mm) EXPECT_LT(r, 1e-4);
+}
+
+TEST(BoneEnergyTest, DirectionsTheLandmarksLeaveOpenKeepThePrior) {
+  const mesh::IndexedMesh bone = ellipsoid(Vector3d(0, 0, -200), Vector3d(25, 20, 200));
+  const Affine3d truth = skewed_affine();
+  // Three landmarks and a fourth 0.5 mm from the first: a plane, whose
+  // normal direction the near pair must not decide.
+  const std::vector<PointTerm> terms = terms_for(
+      bone, {Vector3d(25, 0, -200), Vector3d(-25, 0, -150), Vector3d(0, 0, -390),
+             Vector3d(25, 0.5, -200)},
+      truth);
+  Affine3d skewed_prior = truth;
+  skewed_prior.linear() *= 1.02;
+  const BoneSolution from_skewed = solve_bone(bone, skewed_prior, terms);
+  EXPECT_GT(from_skewed.free_directions, 0);
+  for (const double r : from_skewed.residual_mm) EXPECT_LT(r, 0.5);
+  // The direction across the plane (y) keeps the prior's scale.
+  EXPECT_NEAR((from_skewed.affine.linear() * Vector3d::UnitY()).norm(),
+              (skewed_prior.linear() * Vector3d::UnitY()).norm(), 0.02);
 }
 
 TEST(BoneEnergyTest, APriorThatMeetsEveryTermIsTheClosedFormMinimum) {
