@@ -15,7 +15,8 @@ constexpr std::array<PortTypeInfo, 14> kPortTypes = {{
     {PortType::kMesh, "Mesh",
      "Triangle surface in mm, binary little-endian PLY with double coordinates", ".ply"},
     {PortType::kAtlas, "Atlas",
-     "Musculoskeletal atlas: bones, muscles, attachment areas, action lines, joints, landmarks",
+     "Musculoskeletal atlas: bones, muscles, attachment areas, action lines, joints, landmarks "
+     "(its folder packed as a core/directory_bundle.h bundle)",
      ".atlas"},
     {PortType::kLandmarkSet, "LandmarkSet", "Named 3D points (mm) with provenance, JSON", ".json"},
     {PortType::kRadiographPair, "RadiographPair",

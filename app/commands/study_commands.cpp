@@ -175,7 +175,8 @@ void register_study_commands(CLI::App& app, const workflow::NodeRegistry& regist
       ->required();
   create->add_option("--workflow,-w", create_args->workflow, "Workflow file (.yaml)")->required();
   create->add_option("--input,-i", create_args->inputs,
-                     "Study input NAME=PATH (files) or NAME=VALUE (numbers, text); repeatable");
+                     "Study input NAME=PATH (files), NAME=DIR (an atlas folder) or NAME=VALUE (numbers, "
+                     "text); repeatable");
   create->callback([create_args, &registry] { run_create(*create_args, registry); });
 
   auto set_args = std::make_shared<SetArgs>();

@@ -3,8 +3,11 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <fstream>
+#include <iterator>
 #include <system_error>
 
+#include "core/directory_bundle.h"
 #include "core/errors.h"
 #include "workflow/fault_injection.h"
 #include "workflow/host_and_time.h"
@@ -51,9 +54,46 @@ void copy_atomically(const std::filesystem::path& blob, const std::filesystem::p
   sync_path(target.parent_path(), O_RDONLY | O_DIRECTORY);
 }
 
+// An Atlas export is also unpacked beside its bundle, as the folder people
+// and tools open (atlas.yaml + meshes/): into a temporary folder first, then
+// swapped in, so the folder is always one whole atlas.
+void unpack_atlas_atomically(const std::string& bundle, const std::filesystem::path& target) {
+  const std::filesystem::path temporary =
+      target.parent_path() / ("." + target.filename().string() + ".tmp");
+  std::error_code error;
+  std::filesystem::remove_all(temporary, error);
+  unpack_directory(bundle, temporary, "exported atlas '" + target.filename().string() + "'");
+  std::filesystem::remove_all(target, error);
+  std::filesystem::rename(temporary, target, error);
+  if (error) throw IoError(target, "cannot move the exported atlas into place: " + error.message());
+  sync_path(target.parent_path(), O_RDONLY | O_DIRECTORY);
+}
+
+std::string read_all(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Extension of an opaque File from its first bytes, so that pictures and
+// documents open with a double click.
+std::string sniffed_extension(const std::filesystem::path& blob) {
+  std::ifstream in(blob, std::ios::binary);
+  std::string head(64, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (head.starts_with("\x89PNG\r\n\x1a\n")) return ".png";
+  if (head.starts_with("<svg") || (head.starts_with("<?xml") && head.find("<svg") != std::string::npos)) {
+    return ".svg";
+  }
+  if (head.starts_with("%PDF")) return ".pdf";
+  return "";
+}
+
 }  // namespace
 
-std::string export_file_name(const std::string& name, PortType type) {
+std::string export_file_name(const std::string& name, PortType type,
+                             const std::filesystem::path& blob) {
+  if (type == PortType::kFile && !blob.empty()) return name + sniffed_extension(blob);
   return name + std::string(port_type_info(type).extension);
 }
 
@@ -75,6 +115,9 @@ ExportReport export_outputs(
     if (artifact == nullptr) {
       if (previous == recorded.end()) continue;
       std::filesystem::remove(folder / previous->second.file, error);
+      if (previous->second.file.ends_with(port_type_info(PortType::kAtlas).extension)) {
+        std::filesystem::remove_all(folder / output.name, error);
+      }
       Transaction transaction(study.database());
       study.database()
           .prepare("DELETE FROM exports WHERE name = ?")
@@ -84,18 +127,21 @@ ExportReport export_outputs(
       report.removed.push_back(output.name);
       continue;
     }
-    const std::string file = export_file_name(output.name, artifact->type);
-    const std::filesystem::path target = folder / file;
     const std::filesystem::path blob = study.artifacts().path_of(artifact->hash);
+    const std::string file = export_file_name(output.name, artifact->type, blob);
+    const std::filesystem::path target = folder / file;
+    const bool atlas = artifact->type == PortType::kAtlas;
     if (previous != recorded.end() && previous->second.hash == artifact->hash &&
         previous->second.file == file && std::filesystem::is_regular_file(target, error) &&
-        std::filesystem::file_size(target, error) == std::filesystem::file_size(blob, error)) {
+        std::filesystem::file_size(target, error) == std::filesystem::file_size(blob, error) &&
+        (!atlas || std::filesystem::is_directory(folder / output.name, error))) {
       continue;  // already current
     }
     if (previous != recorded.end() && previous->second.file != file) {
       std::filesystem::remove(folder / previous->second.file, error);
     }
     copy_atomically(blob, target);
+    if (atlas) unpack_atlas_atomically(read_all(blob), folder / output.name);
     Transaction transaction(study.database());
     study.database()
         .prepare(

@@ -1,13 +1,14 @@
 #pragma once
 // The workflow's exported outputs, copied from the artifact store into
 // DIR/outputs/<name><extension> for people and other tools (ParaView opens
-// the .ply, a spreadsheet the .json/.csv). Each file is written to a
+// the .ply, a spreadsheet the .json/.csv, an atlas folder its atlas.yaml). Each file is written to a
 // temporary name, flushed and renamed, so outputs/ never holds a partial
 // file; a file whose content is already current is left alone. An output
 // whose node has no current result (failed, waiting, blocked) has its old
 // file removed, so outputs/ never shows a result that does not match the
 // study's current inputs and parameters.
 
+#include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
@@ -26,7 +27,11 @@ struct ExportReport {
 ExportReport export_outputs(
     Study& study, const std::map<std::string, std::map<std::string, OutputArtifact>>& available);
 
-// The file name of an export: name + the extension of its port type.
-std::string export_file_name(const std::string& name, PortType type);
+// The file name of an export: name + the extension of its port type; for an
+// opaque File, the extension its content shows (.png, .svg, .pdf; none
+// otherwise) when `blob` is given. An Atlas is also unpacked into the
+// folder DIR/outputs/<name>/.
+std::string export_file_name(const std::string& name, PortType type,
+                             const std::filesystem::path& blob = {});
 
 }  // namespace mmm::workflow

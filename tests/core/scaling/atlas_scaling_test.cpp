@@ -19,6 +19,7 @@
 #include "core/scaling/affine_anchor.h"
 #include "core/scaling/bone_energy.h"
 #include "core/scaling/muscle_energy.h"
+#include "tests/support/toy_leg_atlas.h"
 
 namespace mmm::scaling {
 namespace {
@@ -37,14 +38,9 @@ Affine3d skewed_affine() {
   return map;
 }
 
-// An ellipsoid of semi-axes `radii` centred at `centre`.
-mesh::IndexedMesh ellipsoid(const Vector3d& centre, const Vector3d& radii, int subdivisions = 3) {
-  mesh::IndexedMesh surface = mesh::make_icosphere(subdivisions, 1.0);
-  for (Eigen::Index i = 0; i < surface.V.rows(); ++i) {
-    surface.V.row(i) = (centre + radii.cwiseProduct(surface.V.row(i).transpose())).transpose();
-  }
-  return surface;
-}
+using test::ellipsoid;
+using test::toy_leg;
+using test::ToyLeg;
 
 Eigen::MatrixX3d mapped(const Affine3d& map, const Eigen::MatrixX3d& V) {
   return (V * map.linear().transpose()).rowwise() + map.translation().transpose();
@@ -243,99 +239,6 @@ TEST(MuscleEnergyTest, AMuscleTheBlendWouldPushIntoABoneComesOutOfIt) {
   EXPECT_NEAR(after.volume_ratio, before.volume_ratio, 0.05);
 }
 
-
-// A small leg with meshes: pelvis -hip-> femur -knee-> tibia -ankle-> talus,
-// the patella welded to the tibia, a muscle along the femur, and one of
-// every derived element.
-struct ToyLeg {
-  atlas::Atlas atlas;
-  atlas::AtlasMeshes meshes;
-};
-
-ToyLeg toy_leg() {
-  ToyLeg leg;
-  atlas::Atlas& a = leg.atlas;
-  a.name = "toy_leg";
-  const Vector3d hip(80, 0, -50), knee(85, 10, -450), ankle(70, 0, -830);
-  const auto add_bone = [&](const std::string& name, const Vector3d& centre, const Vector3d& radii) {
-    atlas::Bone bone;
-    bone.name = name;
-    bone.frame.translation() = centre;
-    bone.meshes = {{"full", "meshes/" + name + "/full.ply", 0},
-                   {"lod1", "meshes/" + name + "/lod1.ply", 0}};
-    a.bones.push_back(bone);
-    leg.meshes[name]["full"] = ellipsoid(centre, radii, 3);
-    leg.meshes[name]["lod1"] = ellipsoid(centre, radii, 2);
-  };
-  add_bone("pelvis", Vector3d(40, 0, 0), Vector3d(70, 40, 45));
-  add_bone("femur_r", 0.5 * (hip + knee), Vector3d(18, 18, 205));
-  add_bone("tibia_r", 0.5 * (knee + ankle), Vector3d(16, 16, 195));
-  add_bone("patella_r", Vector3d(88, 45, -440), Vector3d(12, 8, 14));
-  add_bone("talus_r", ankle, Vector3d(15, 20, 12));
-  const auto joint = [](const std::string& name, const std::string& parent,
-                        const std::string& child, const Vector3d& centre, atlas::JointType type) {
-    atlas::Joint j;
-    j.name = name;
-    j.type = type;
-    j.parent = parent;
-    j.child = child;
-    j.parent_frame.translation() = centre;
-    j.child_frame.translation() = centre;
-    return j;
-  };
-  a.joints = {joint("hip_r", "pelvis", "femur_r", hip, atlas::JointType::kBall),
-              joint("knee_r", "femur_r", "tibia_r", knee, atlas::JointType::kPin),
-              joint("patella_weld", "tibia_r", "patella_r", Vector3d(88, 45, -440),
-                    atlas::JointType::kWeld),
-              joint("ankle_r", "tibia_r", "talus_r", ankle, atlas::JointType::kPin)};
-  const auto landmark = [](const std::string& name, const std::string& bone, const Vector3d& p) {
-    atlas::Landmark l;
-    l.name = name;
-    l.bone = bone;
-    l.position = p;
-    return l;
-  };
-  a.landmarks = {landmark("femoral_head_centre_r", "femur_r", Vector3d(81, 0.5, -49)),
-                 landmark("patella_centre_r", "patella_r", Vector3d(88, 45, -440)),
-                 landmark("ankle_centre_r", "tibia_r", Vector3d(71, 1, -828)),
-                 landmark("lateral_epicondyle_r", "femur_r", Vector3d(103, 10, -440))};
-  atlas::Marker marker;
-  marker.name = "R.Thigh";
-  marker.bone = "femur_r";
-  marker.position = Vector3d(125, 0, -300);
-  a.markers = {marker};
-  atlas::Muscle muscle;
-  muscle.name = "vastus_r";
-  muscle.meshes = {{"full", "meshes/vastus_r/full.ply", 0},
-                   {"lod1", "meshes/vastus_r/lod1.ply", 0}};
-  leg.meshes["vastus_r"]["full"] = ellipsoid(Vector3d(108.5, 5, -250), Vector3d(10, 10, 150), 3);
-  leg.meshes["vastus_r"]["lod1"] = ellipsoid(Vector3d(108.5, 5, -250), Vector3d(10, 10, 150), 2);
-  atlas::ActionLine line;
-  line.name = "vastus_r";
-  const auto point = [](const std::string& name, const std::string& bone, const Vector3d& p) {
-    atlas::PathPoint path_point;
-    path_point.name = name;
-    path_point.bone = bone;
-    path_point.position = p;
-    return path_point;
-  };
-  line.points = {point("origin", "femur_r", Vector3d(100, 5, -150)),
-                 point("insertion", "tibia_r", Vector3d(90, 30, -480))};
-  muscle.action_lines = {line};
-  atlas::AttachmentArea origin;
-  origin.bone = "femur_r";
-  origin.faces = {0, 1, 2};
-  origin.centroid = Vector3d(98, 5, -150);
-  muscle.origins = {origin};
-  atlas::WrapObstacle wrap;
-  wrap.name = "knee_wrap";
-  wrap.bone = "femur_r";
-  wrap.pose.translation() = Vector3d(85, 10, -430);
-  wrap.radii = Vector3d(20, 0, 0);
-  muscle.wrap_obstacles = {wrap};
-  a.muscles = {muscle};
-  return leg;
-}
 
 landmarks::LandmarkSet station_landmarks(const atlas::Atlas& a, const Affine3d& map) {
   landmarks::LandmarkSet set;
