@@ -340,7 +340,8 @@ void accuracy_table(std::ostream& out) {
   }
   out << "\n";
   nlohmann::json document = {{"table", table}, {"patients", per_patient},
-                             {"prepare_seconds", l.prepared->prepare_seconds}};
+                             {"prepare_seconds", l.prepared->prepare_seconds},
+                             {"prepare_anchors_seconds", l.prepared->anchors_seconds}};
   document["real_data"] = real_data_check(out);
   const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
   std::ofstream file(std::filesystem::path(out_dir != nullptr ? out_dir : ".") /

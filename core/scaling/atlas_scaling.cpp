@@ -146,6 +146,7 @@ std::shared_ptr<const PreparedAtlas> prepare_atlas(atlas::Atlas atlas, atlas::At
       }
     }
   });
+  prepared->anchors_seconds = seconds_since(start);
   std::vector<BoneAtRest> bones;
   for (const atlas::Bone& bone : a.bones) {
     bones.push_back({bone.name, &full_mesh(prepared->meshes, bone.name),
@@ -405,7 +406,7 @@ nlohmann::json scaling_report_json(const ScaledAtlas& scaled) {
   for (const BoneScaling& bone : scaled.bones) {
     json entry = {{"bone", bone.bone},
                   {"solve", !bone.welded_to.empty() ? "welded to " + bone.welded_to
-                            : bone.bent             ? "affine fit + Laplacian detail (sparse LDLT)"
+                            : bone.bent             ? "affine fit + Laplacian detail (sparse Cholesky)"
                             : bone.solved           ? "affine fit"
                                                     : "first stage (meets every term)"},
                   {"affine_directions_from_first_stage", bone.free_directions},

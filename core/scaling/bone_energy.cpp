@@ -1,12 +1,12 @@
 #include "core/scaling/bone_energy.h"
 
 #include <Eigen/Dense>
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 
 #include "core/errors.h"
 #include "core/mesh/laplacian.h"
+#include "core/scaling/sparse_cholesky.h"
 
 namespace mmm::scaling {
 namespace {
@@ -140,9 +140,9 @@ BoneSolution solve_bone(const mesh::IndexedMesh& rest, const Eigen::Affine3d& pr
   SparseMatrix identity(n, n);
   identity.setIdentity();
   K += gauge * identity;
-  const Eigen::SimplicialLDLT<SparseMatrix> factor(K);
+  const SparseCholesky factor(K);
   if (factor.info() != Eigen::Success) {
-    throw SolverError("bone energy: the sparse LDLT factorisation of the detail term failed");
+    throw SolverError("bone energy: the sparse Cholesky factorisation of the detail term failed");
   }
   const Eigen::MatrixX3d misfit = targets - A * solution.vertices;
   for (int k = 0; k < 3; ++k) {

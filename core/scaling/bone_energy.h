@@ -26,7 +26,7 @@
 //     point terms on the rest,
 //       min w_L |L d|^2 + sum_j w_j |a_j . (x_affine + d) - p_j|^2 + w_d |d|^2,
 //     L the cotangent Laplacian, w_d a tiny gauge: a smooth bend, one
-//     sparse LDLT factorisation shared by the three coordinates.
+//     sparse Cholesky factorisation shared by the three coordinates.
 // When g0 already meets every point term within closed_form_tolerance_mm
 // nothing is solved (E = 0 there); when the affine fit meets them, no bend.
 

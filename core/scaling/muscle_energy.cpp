@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <utility>
+#include <optional>
 #include <set>
 
 #include "core/errors.h"
@@ -27,6 +30,38 @@ double excess_depth(double signed_distance, double rest_signed_distance, double 
   return std::max(0.0, -signed_distance) - bone_scale * std::max(0.0, -rest_signed_distance);
 }
 
+// Spreads the low 21 bits of v over every third bit.
+std::uint64_t spread_bits(std::uint64_t v) {
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffULL;
+  v = (v | v << 16) & 0x1f0000ff0000ffULL;
+  v = (v | v << 8) & 0x100f00f00f00f00fULL;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+  v = (v | v << 2) & 0x1249249249249249ULL;
+  return v;
+}
+
+// Rows of V sorted along the Morton curve of a 2^21 grid over their box.
+std::vector<Eigen::Index> morton_order(const Eigen::MatrixX3d& V) {
+  const Eigen::RowVector3d low = V.colwise().minCoeff();
+  const double extent = std::max((V.colwise().maxCoeff() - low).maxCoeff(), 1e-9);
+  const double cells = static_cast<double>((1U << 21U) - 1U);
+  std::vector<std::pair<std::uint64_t, Eigen::Index>> keyed(static_cast<std::size_t>(V.rows()));
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    std::uint64_t code = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+      const auto cell = static_cast<std::uint64_t>((V(i, axis) - low[axis]) / extent * cells);
+      code |= spread_bits(cell) << axis;
+    }
+    keyed[static_cast<std::size_t>(i)] = {code, i};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<Eigen::Index> order;
+  order.reserve(keyed.size());
+  for (const auto& entry : keyed) order.push_back(entry.second);
+  return order;
+}
+
 }  // namespace
 
 PreparedMuscle prepare_muscle(const std::string& name, const mesh::IndexedMesh& surface,
@@ -47,12 +82,29 @@ PreparedMuscle prepare_muscle(const std::string& name, const mesh::IndexedMesh& 
   muscle.blend.resize(n, bone_count);
   const double eps2 = options.blend_radius_mm * options.blend_radius_mm;
   std::vector<double> coarse_distance(bones.size());
-  for (Eigen::Index i = 0; i < n; ++i) {
+  // The distance to a surface is 1-Lipschitz: the previous vertex's answer
+  // plus the step bounds this one's, which prunes most of each tree (the
+  // answer is exact either way).
+  // Visiting the vertices in Morton (Z-curve) order keeps consecutive ones
+  // close, so that bound is tight.
+  Vector3d previous = surface.V.row(0).transpose();
+  std::vector<double> previous_distance(bones.size(), -1.0);
+  for (const Eigen::Index i : morton_order(surface.V)) {
     const Vector3d p = surface.V.row(i).transpose();
+    const double step = (p - previous).norm();
+    previous = p;
     double total = 0.0;
     for (Eigen::Index b = 0; b < bone_count; ++b) {
-      const double d2 = coarse[static_cast<std::size_t>(b)].closest_point(p).squared_distance;
-      coarse_distance[static_cast<std::size_t>(b)] = std::sqrt(d2);
+      const auto bb = static_cast<std::size_t>(b);
+      std::optional<mesh::AabbTree::ClosestPoint> closest;
+      if (previous_distance[bb] >= 0.0) {
+        const double bound = previous_distance[bb] + step + 1e-9;
+        closest = coarse[bb].closest_point_within(p, bound * bound);
+      }
+      if (!closest) closest = coarse[bb].closest_point(p);
+      const double d2 = closest->squared_distance;
+      previous_distance[bb] = std::sqrt(d2);
+      coarse_distance[bb] = previous_distance[bb];
       muscle.blend(i, b) = 1.0 / (d2 + eps2);
       total += muscle.blend(i, b);
     }
@@ -64,8 +116,14 @@ PreparedMuscle prepare_muscle(const std::string& name, const mesh::IndexedMesh& 
       if (coarse_distance[static_cast<std::size_t>(b)] > options.band_mm + kCoarseMarginMm) {
         continue;
       }
-      const double sd = bones[static_cast<std::size_t>(b)].distance->at(p);
-      if (sd >= options.band_mm) continue;
+      // Unsigned first (a pruned closest-point query); the sign (a winding
+      // number, the dearer half) only for vertices within the band.
+      const mesh::SignedDistance& distance = *bones[static_cast<std::size_t>(b)].distance;
+      const std::optional<mesh::AabbTree::ClosestPoint> closest =
+          distance.tree().closest_point_within(p, options.band_mm * options.band_mm);
+      if (!closest) continue;
+      const double unsigned_distance = std::sqrt(closest->squared_distance);
+      const double sd = distance.winding().is_inside(p) ? -unsigned_distance : unsigned_distance;
       muscle.band.push_back(static_cast<int>(i));
       muscle.band_bone.push_back(static_cast<int>(b));
       muscle.band_rest_distance.push_back(sd);
@@ -91,9 +149,9 @@ PreparedMuscle prepare_muscle(const std::string& name, const mesh::IndexedMesh& 
   }
   for (const int i : muscle.attached) diagonal[i] += options.attachment_weight;
   K += SparseMatrix(diagonal.asDiagonal());
-  muscle.factor = std::make_shared<Eigen::SimplicialLDLT<SparseMatrix>>(K);
+  muscle.factor = std::make_shared<SparseCholesky>(K);
   if (muscle.factor->info() != Eigen::Success) {
-    throw SolverError("muscle energy '" + name + "': the sparse LDLT factorisation failed");
+    throw SolverError("muscle energy '" + name + "': the sparse Cholesky factorisation failed");
   }
   muscle.rest_volume_mm3 = mesh::signed_volume(surface);
   return muscle;

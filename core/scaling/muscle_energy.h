@@ -22,15 +22,17 @@
 // (that depth scaled with the bone: the atlas's own overlaps are not new)
 // plus a tolerance has its q_i moved out by its excess depth (+ a margin)
 // along the direction to the bone surface, and the problem is solved again.
-// Only band vertices are tested: one farther than band_mm from every bone at
+// Only band vertices are tested (a vertex farther than band_mm from a bone's
+// surface at rest is out of its band, inside or not: a muscle 10 mm deep in
+// a bone is a broken atlas, which atlas check reports). One farther than band_mm from every bone at
 // rest would need the blend to move it that much more than the bone under
 // it, far beyond the maps' differences near a joint in any human scaling.
 // Every term's weights and vertex sets depend on the atlas alone, so the
 // matrix w_L L^T L + W_a + W_b + w_d I is factored once per muscle in
-// prepare_muscle and every patient and iteration is back-substitutions.
+// prepare_muscle (CHOLMOD, sparse_cholesky.h) and every patient and
+// iteration is back-substitutions.
 
 #include <Eigen/Geometry>
-#include <Eigen/SparseCholesky>
 #include <map>
 #include <memory>
 #include <string>
@@ -39,6 +41,7 @@
 #include "core/mesh/mesh.h"
 #include "core/mesh/signed_distance.h"
 #include "core/scaling/affine_anchor.h"
+#include "core/scaling/sparse_cholesky.h"
 
 namespace mmm::scaling {
 
@@ -79,7 +82,7 @@ struct PreparedMuscle {
   std::vector<int> band_bone;
   std::vector<double> band_rest_distance;  // signed distance at rest (mm; < 0 inside)
   double rest_volume_mm3 = 0.0;
-  std::shared_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> factor;
+  std::shared_ptr<SparseCholesky> factor;  // not shared between threads while solving
 };
 
 // Throws InvalidInputError for an invalid mesh, SolverError when the
