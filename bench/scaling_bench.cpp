@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -250,10 +251,23 @@ void accuracy_table(std::ostream& out) {
   const int patients = std::getenv("MMM_BENCH_PATIENTS") != nullptr
                            ? std::atoi(std::getenv("MMM_BENCH_PATIENTS"))
                            : 10;
-  std::vector<std::string> with_bony = kStation;
-  with_bony.insert(with_bony.end(), kBony.begin(), kBony.end());
-  const std::vector<std::string> methods = {"ours: station (H,P,A)", "ours: station + bony",
-                                            "uniform baseline (H,P,A)"};
+  // Each method: a name, the landmarks it is given, whether it is ours.
+  struct Method {
+    std::string name;
+    std::vector<std::string> landmarks;
+    bool ours = true;
+  };
+  const auto plus = [](std::vector<std::string> names, const std::vector<std::string>& more) {
+    names.insert(names.end(), more.begin(), more.end());
+    return names;
+  };
+  const std::vector<Method> method_list = {
+      {"ours: station (H,P,A)", kStation, true},
+      {"ours: station + ASIS", plus(kStation, {"asis_r", "asis_l"}), true},
+      {"ours: station + bony", plus(kStation, kBony), true},
+      {"uniform baseline (H,P,A)", kStation, false}};
+  std::vector<std::string> methods;
+  for (const Method& method : method_list) methods.push_back(method.name);
   std::map<std::string, std::vector<Accuracy>> results;
   nlohmann::json per_patient = nlohmann::json::array();
   for (int p = 0; p < patients; ++p) {
@@ -263,11 +277,10 @@ void accuracy_table(std::ostream& out) {
     nlohmann::json row = {{"seed", seed}, {"height_mm", height}};
     std::map<std::string, double> last_residuals;
     nlohmann::json last_report;
-    for (const std::string& method : methods) {
-      const bool bony = method == methods[1];
-      const LandmarkSet set = landmark_set(truth.atlas, bony ? with_bony : kStation);
+    for (const Method& method : method_list) {
+      const LandmarkSet set = landmark_set(truth.atlas, method.landmarks);
       Accuracy a;
-      if (method == methods[2]) {
+      if (!method.ours) {
         const scaling::ScalingEstimate estimate = scaling::estimate_uniform_scaling(l.atlas, set);
         a = measure(l, truth, uniform_meshes(l, estimate), set, estimate.landmark_residual_mm);
       } else {
@@ -280,9 +293,9 @@ void accuracy_table(std::ostream& out) {
               std::max(a.penetration_max_mm, muscle.solution.excess_depth_after_mm);
         }
       }
-      row[method] = to_json(a);
-      if (method != methods[2]) row[method]["landmark_residual_mm"] = last_residuals;
-      results[method].push_back(a);
+      row[method.name] = to_json(a);
+      if (method.ours) row[method.name]["landmark_residual_mm"] = last_residuals;
+      results[method.name].push_back(a);
     }
     if (p == 0) row["report_of_ours_with_bony_landmarks"] = last_report;
     per_patient.push_back(row);
@@ -310,24 +323,22 @@ void accuracy_table(std::ostream& out) {
   out << "\nscaling accuracy over " << patients
       << " synthetic patients (seeds 101.., statures 1500-2050 mm), exact landmarks;\n"
       << "each cell: median over patients / worst patient\n";
-  std::snprintf(line, sizeof line, "%-34s %-22s %-22s %-24s %s\n", "metric", methods[0].c_str(),
-                methods[1].c_str(), methods[2].c_str(), "target");
-  out << line;
+  out << std::left << std::setw(34) << "metric";
+  for (const std::string& method : methods) out << " " << std::setw(24) << method;
+  out << " target\n";
   nlohmann::json table = nlohmann::json::array();
   for (const Row& row : rows) {
-    std::string cells[3];
     nlohmann::json entry = {{"metric", row.label}, {"target", row.target}};
-    for (int m = 0; m < 3; ++m) {
-      const double med = column(methods[static_cast<std::size_t>(m)], row.field, false);
-      const double worst = column(methods[static_cast<std::size_t>(m)], row.field, true);
+    out << std::setw(34) << row.label;
+    for (const std::string& method : methods) {
+      const double med = column(method, row.field, false);
+      const double worst = column(method, row.field, true);
       char cell[64];
       std::snprintf(cell, sizeof cell, "%.3f / %.3f", med, worst);
-      cells[m] = cell;
-      entry[methods[static_cast<std::size_t>(m)]] = {{"median", med}, {"worst", worst}};
+      out << " " << std::setw(24) << cell;
+      entry[method] = {{"median", med}, {"worst", worst}};
     }
-    std::snprintf(line, sizeof line, "%-34s %-22s %-22s %-24s %s\n", row.label, cells[0].c_str(),
-                  cells[1].c_str(), cells[2].c_str(), row.target);
-    out << line;
+    out << " " << row.target << "\n";
     table.push_back(entry);
   }
   // Per bone, ours with the station landmarks: where the error is.

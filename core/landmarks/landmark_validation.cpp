@@ -209,16 +209,24 @@ ValidationResult validate_submission(std::span<const image::RadiographView> view
   result.midline_x_mm = rules.midline_x_mm ? *rules.midline_x_mm : central_ray_crossing_x(views);
   const bool right = rules.side == "right";
   for (const Landmark& landmark : triangulated.landmarks) {
+    // The pelvis's landmarks of the other side (the far ASIS) belong there.
+    const bool other_side = std::find(rules.opposite_side.begin(), rules.opposite_side.end(),
+                                      landmark.name) != rules.opposite_side.end();
+    const bool expect_right = right != other_side;
+    const std::string expected = expect_right ? "right" : "left";
     // Lateral distance toward the expected side (+x is the subject's right).
-    const double lateral = right ? landmark.position_mm.x() - result.midline_x_mm
-                                 : result.midline_x_mm - landmark.position_mm.x();
+    const double lateral = expect_right ? landmark.position_mm.x() - result.midline_x_mm
+                                        : result.midline_x_mm - landmark.position_mm.x();
     if (lateral < rules.side_margin_mm) {
       reasons.push_back("Landmark '" + landmark.name + "' lies " + mm(std::abs(lateral)) +
-                        " mm to the subject's " + ((lateral >= 0) == right ? "right" : "left") +
-                        " of the midline (x = " + mm(result.midline_x_mm) +
-                        " mm); a landmark of the " + rules.side + " leg must lie at least " +
-                        mm(rules.side_margin_mm) + " mm to the subject's " + rules.side +
-                        " (the other leg clicked?).");
+                        " mm to the subject's " +
+                        ((lateral >= 0) == expect_right ? "right" : "left") +
+                        " of the midline (x = " + mm(result.midline_x_mm) + " mm); " +
+                        (other_side ? "a landmark of the other side"
+                                    : "a landmark of the " + rules.side + " leg") +
+                        " must lie at least " + mm(rules.side_margin_mm) +
+                        " mm to the subject's " + expected +
+                        (other_side ? " (the two sides swapped?)." : " (the other leg clicked?)."));
     }
   }
   if (!triangulated.landmarks.empty()) result.landmarks = std::move(triangulated);

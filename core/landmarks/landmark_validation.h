@@ -76,6 +76,9 @@ struct ValidationRules {
   // isocentre ~10 mm off the midline toward that leg, while the other leg's
   // landmarks (mirror images, 40 mm or more to the other side) fail.
   double side_margin_mm = 10.0;
+  // Landmarks that belong to the other side of the midline (for a right leg,
+  // the left ASIS when the pelvis's landmarks are asked for).
+  std::vector<std::string> opposite_side;
 
   // Landmarks in order from superior to inferior: each present landmark must
   // be higher (larger z) than the next present one.

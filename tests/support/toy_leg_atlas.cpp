@@ -33,7 +33,7 @@ ToyLeg toy_leg() {
     leg.meshes[name]["full"] = ellipsoid(centre, radii, 3);
     leg.meshes[name]["lod1"] = ellipsoid(centre, radii, 2);
   };
-  add_bone("pelvis", Vector3d(40, 0, 0), Vector3d(70, 40, 45));
+  add_bone("pelvis", Vector3d(45, 0, 0), Vector3d(120, 40, 45));
   add_bone("femur_r", 0.5 * (hip + knee), Vector3d(18, 18, 205));
   add_bone("tibia_r", 0.5 * (knee + ankle), Vector3d(16, 16, 195));
   add_bone("patella_r", Vector3d(88, 45, -440), Vector3d(12, 8, 14));
@@ -76,7 +76,9 @@ ToyLeg toy_leg() {
   a.landmarks = {landmark("femoral_head_centre_r", "femur_r", Vector3d(81, 0.5, -49)),
                  landmark("patella_centre_r", "patella_r", Vector3d(88, 45, -440)),
                  landmark("ankle_centre_r", "tibia_r", Vector3d(71, 1, -828)),
-                 landmark("lateral_epicondyle_r", "femur_r", Vector3d(103, 10, -440))};
+                 landmark("lateral_epicondyle_r", "femur_r", Vector3d(103, 10, -440)),
+                 landmark("asis_r", "pelvis", Vector3d(150, 30, 20)),
+                 landmark("asis_l", "pelvis", Vector3d(-60, 30, 20))};
   atlas::Marker marker;
   marker.name = "R.Thigh";
   marker.bone = "femur_r";

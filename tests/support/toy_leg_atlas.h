@@ -2,7 +2,8 @@
 // A small leg atlas with meshes for tests of atlas scaling: pelvis -hip->
 // femur_r -knee-> tibia_r -ankle-> talus_r, the patella welded to the tibia
 // (as in the default atlas), ellipsoid surfaces at two levels of detail
-// ("full", "lod1"), the station's three landmarks plus a lateral epicondyle,
+// ("full", "lod1"), the station's three landmarks plus a lateral epicondyle
+// and both ASIS,
 // a thigh marker, and a muscle along the femur (2 mm into it, as atlas
 // segmentations overlap) with an action line, an attachment area and a wrap
 // obstacle.

@@ -291,3 +291,42 @@ TEST(LandmarkValidationTest, BadRulesOrViewsThrow) {
 
 }  // namespace
 }  // namespace mmm::landmarks
+
+namespace mmm::landmarks {
+namespace {
+
+// The pelvis's landmarks of a right-leg task: the left ASIS belongs to the
+// left of the midline, and swapping the two ASIS is caught.
+TEST(LandmarkValidationTest, TheOtherSidesAsisBelongsOnTheOtherSide) {
+  const auto views = leg_views();
+  ValidationRules rules;
+  rules.required.push_back("asis_r");
+  rules.required.push_back("asis_l");
+  rules.opposite_side = {"asis_l"};
+  const Eigen::Vector3d asis_r(120, 60, 960);
+  const Eigen::Vector3d asis_l(-120, 60, 960);
+  const ValidationResult accepted =
+      validate_submission(views,
+                          submit(views, {{"femoral_head_centre_r", kHead},
+                                         {"patella_centre_r", kPatella},
+                                         {"ankle_centre_r", kAnkle},
+                                         {"asis_r", asis_r},
+                                         {"asis_l", asis_l}}),
+                          rules);
+  EXPECT_THAT(accepted.reasons, IsEmpty());
+  const ValidationResult swapped =
+      validate_submission(views,
+                          submit(views, {{"femoral_head_centre_r", kHead},
+                                         {"patella_centre_r", kPatella},
+                                         {"ankle_centre_r", kAnkle},
+                                         {"asis_r", asis_l},
+                                         {"asis_l", asis_r}}),
+                          rules);
+  EXPECT_THAT(swapped.reasons, Contains(HasSubstr("a landmark of the other side must lie at least "
+                                            "10.0 mm to the subject's left (the two sides "
+                                            "swapped?)")))
+      << ::testing::PrintToString(swapped.reasons);
+}
+
+}  // namespace
+}  // namespace mmm::landmarks
