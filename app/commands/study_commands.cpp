@@ -174,9 +174,10 @@ void register_study_commands(CLI::App& app, const workflow::NodeRegistry& regist
   create->add_option("DIR", create_args->dir, "New study folder (must not exist or be empty)")
       ->required();
   create->add_option("--workflow,-w", create_args->workflow, "Workflow file (.yaml)")->required();
-  create->add_option("--input,-i", create_args->inputs,
-                     "Study input NAME=PATH (files), NAME=DIR (an atlas folder) or NAME=VALUE (numbers, "
-                     "text); repeatable");
+  create->add_option(
+      "--input,-i", create_args->inputs,
+      "Study input NAME=PATH (files), NAME=DIR (an atlas folder) or NAME=VALUE (numbers, "
+      "text); repeatable");
   create->callback([create_args, &registry] { run_create(*create_args, registry); });
 
   auto set_args = std::make_shared<SetArgs>();

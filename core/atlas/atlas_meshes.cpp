@@ -46,8 +46,7 @@ void write_atlas_with_meshes(const Atlas& atlas, const AtlasMeshes& meshes,
   std::vector<const mesh::IndexedMesh*> source(jobs.size());
   for (std::size_t i = 0; i < jobs.size(); ++i) {
     const auto element = meshes.find(jobs[i].element);
-    const bool found =
-        element != meshes.end() && element->second.contains(jobs[i].level->level);
+    const bool found = element != meshes.end() && element->second.contains(jobs[i].level->level);
     if (!found) {
       throw InvalidInputError("atlas '" + atlas.name + "': no '" + jobs[i].level->level +
                               "' mesh for '" + jobs[i].element + "' to write");

@@ -16,7 +16,8 @@ using AtlasMeshes = std::map<std::string, std::map<std::string, mesh::IndexedMes
 
 // Reads every level of every bone and muscle (threads > 1: in parallel).
 // Throws IoError naming the file that cannot be read.
-AtlasMeshes read_atlas_meshes(const Atlas& atlas, const std::filesystem::path& dir, int threads = 2);
+AtlasMeshes read_atlas_meshes(const Atlas& atlas, const std::filesystem::path& dir,
+                              int threads = 2);
 
 // Writes every mesh at its MeshLevel file under `dir`, then the manifest.
 // Throws InvalidInputError when a mesh of the atlas is missing from `meshes`,

@@ -218,15 +218,14 @@ ValidationResult validate_submission(std::span<const image::RadiographView> view
     const double lateral = expect_right ? landmark.position_mm.x() - result.midline_x_mm
                                         : result.midline_x_mm - landmark.position_mm.x();
     if (lateral < rules.side_margin_mm) {
-      reasons.push_back("Landmark '" + landmark.name + "' lies " + mm(std::abs(lateral)) +
-                        " mm to the subject's " +
-                        ((lateral >= 0) == expect_right ? "right" : "left") +
-                        " of the midline (x = " + mm(result.midline_x_mm) + " mm); " +
-                        (other_side ? "a landmark of the other side"
-                                    : "a landmark of the " + rules.side + " leg") +
-                        " must lie at least " + mm(rules.side_margin_mm) +
-                        " mm to the subject's " + expected +
-                        (other_side ? " (the two sides swapped?)." : " (the other leg clicked?)."));
+      reasons.push_back(
+          "Landmark '" + landmark.name + "' lies " + mm(std::abs(lateral)) +
+          " mm to the subject's " + ((lateral >= 0) == expect_right ? "right" : "left") +
+          " of the midline (x = " + mm(result.midline_x_mm) + " mm); " +
+          (other_side ? "a landmark of the other side"
+                      : "a landmark of the " + rules.side + " leg") +
+          " must lie at least " + mm(rules.side_margin_mm) + " mm to the subject's " + expected +
+          (other_side ? " (the two sides swapped?)." : " (the other leg clicked?)."));
     }
   }
   if (!triangulated.landmarks.empty()) result.landmarks = std::move(triangulated);

@@ -99,7 +99,8 @@ std::vector<int> VertexGrid::nearest(const Eigen::Vector3d& query, int k) const 
   }
   std::partial_sort(found.begin(), found.begin() + k, found.end());
   std::vector<int> rows(static_cast<std::size_t>(k));
-  for (int i = 0; i < k; ++i) rows[static_cast<std::size_t>(i)] = found[static_cast<std::size_t>(i)].second;
+  for (int i = 0; i < k; ++i)
+    rows[static_cast<std::size_t>(i)] = found[static_cast<std::size_t>(i)].second;
   return rows;
 }
 

@@ -43,8 +43,8 @@ class AnchorBuilder {
 
  private:
   mesh::VertexGrid grid_;
-  mesh::VertexGrid spread_;        // over a subsample of the vertices
-  std::vector<int> spread_rows_;   // its rows -> vertex rows
+  mesh::VertexGrid spread_;       // over a subsample of the vertices
+  std::vector<int> spread_rows_;  // its rows -> vertex rows
   int k_ = 16;
 };
 

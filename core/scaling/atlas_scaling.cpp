@@ -191,8 +191,8 @@ std::vector<PointTerm> bone_terms(const PreparedAtlas& prepared, const atlas::Bo
     const Vector3d centre = joint->child_frame.translation();
     const Vector3d target = reconstruct(prepared.anchors.at(joint->parent)->anchor(centre),
                                         placed.vertices.at(joint->parent));
-    terms.push_back({"joint " + joint->name, anchors.anchor(centre), centre, target,
-                     options.joint_weight});
+    terms.push_back(
+        {"joint " + joint->name, anchors.anchor(centre), centre, target, options.joint_weight});
   }
   // Distal joints: where the first stage puts them, weakly — a prior for
   // what the bone's own landmarks leave open, not a rival of them (the child
@@ -295,7 +295,8 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
   }
   if (!scaled.unused_landmarks.empty()) {
     std::string names;
-    for (const std::string& name : scaled.unused_landmarks) names += (names.empty() ? "" : ", ") + name;
+    for (const std::string& name : scaled.unused_landmarks)
+      names += (names.empty() ? "" : ", ") + name;
     scaled.notes.push_back("landmarks not in the atlas, not used: " + names);
   }
   scaled.timings.anatomical_s = seconds_since(start);
@@ -317,8 +318,8 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
     } else {
       const std::vector<PointTerm> terms =
           bone_terms(prepared, *bone, landmarks, scaled.first_stage, placed, options);
-      BoneSolution solution = solve_bone(rest, scaled.first_stage.deformation.bone_maps.at(bone->name),
-                                         terms, options.bone);
+      BoneSolution solution = solve_bone(
+          rest, scaled.first_stage.deformation.bone_maps.at(bone->name), terms, options.bone);
       report = describe_bone(a, *bone, solution.affine);
       report.solved = solution.solved;
       report.bent = solution.bent;
@@ -346,7 +347,8 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
   stage = Clock::now();
   std::vector<std::unique_ptr<mesh::SignedDistance>> distance(a.bones.size());
   parallel_for(a.bones.size(), options.threads, [&](std::size_t b) {
-    distance[b] = std::make_unique<mesh::SignedDistance>(scaled.meshes.at(a.bones[b].name).at("full"));
+    distance[b] =
+        std::make_unique<mesh::SignedDistance>(scaled.meshes.at(a.bones[b].name).at("full"));
   });
   std::vector<ScaledBone> bones;
   for (std::size_t b = 0; b < a.bones.size(); ++b) {
@@ -382,10 +384,10 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
       }
     }
   }
-  scaled.atlas.provenance.push_back("scaled by mmm scale_atlas onto " +
-                                    std::to_string(landmarks.landmarks.size()) + " landmarks (" +
-                                    (landmarks.source.empty() ? "unknown source" : landmarks.source) +
-                                    ", frame " + landmarks.frame + ")");
+  scaled.atlas.provenance.push_back(
+      "scaled by mmm scale_atlas onto " + std::to_string(landmarks.landmarks.size()) +
+      " landmarks (" + (landmarks.source.empty() ? "unknown source" : landmarks.source) +
+      ", frame " + landmarks.frame + ")");
   scaled.timings.elements_s = seconds_since(stage);
   scaled.timings.total_s = seconds_since(start);
   return scaled;
@@ -406,9 +408,9 @@ nlohmann::json scaling_report_json(const ScaledAtlas& scaled) {
   for (const BoneScaling& bone : scaled.bones) {
     json entry = {{"bone", bone.bone},
                   {"solve", !bone.welded_to.empty() ? "welded to " + bone.welded_to
-                            : bone.bent             ? "affine fit + Laplacian detail (sparse Cholesky)"
-                            : bone.solved           ? "affine fit"
-                                                    : "first stage (meets every term)"},
+                            : bone.bent   ? "affine fit + Laplacian detail (sparse Cholesky)"
+                            : bone.solved ? "affine fit"
+                                          : "first stage (meets every term)"},
                   {"affine_directions_from_first_stage", bone.free_directions},
                   {"stretches", {bone.stretches.x(), bone.stretches.y(), bone.stretches.z()}},
                   {"volume_scale", bone.affine.linear().determinant()}};

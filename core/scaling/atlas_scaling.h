@@ -55,8 +55,8 @@ struct AtlasScalingOptions {
   ScalingOptions anatomical;
   BoneEnergyOptions bone;
   MuscleEnergyOptions muscle;
-  double landmark_weight = 100.0;  // per mm^2
-  double joint_weight = 100.0;     // per mm^2: a bone's joint with its parent
+  double landmark_weight = 100.0;    // per mm^2
+  double joint_weight = 100.0;       // per mm^2: a bone's joint with its parent
   double distal_joint_weight = 1.0;  // per mm^2: its joints with its children
   int anchor_vertices = 16;
   int threads = 2;
@@ -83,15 +83,15 @@ std::shared_ptr<const PreparedAtlas> prepare_atlas(atlas::Atlas atlas, atlas::At
 
 struct BoneScaling {
   std::string bone;
-  bool solved = false;            // false: the first stage met every term, or welded
-  bool bent = false;              // the Laplacian detail step ran
-  int free_directions = 0;        // affine directions kept from the first stage
-  std::string welded_to;          // non-empty for welded bones
-  Eigen::Affine3d affine;         // affine part of its placement (atlas -> patient)
-  double length_factor = 1.0;     // along its long axis (0 when it has none)
-  Eigen::Vector3d stretches;      // singular values of the affine's linear part, largest first
-  std::vector<std::string> terms;         // point terms used, in order
-  std::vector<double> term_residual_mm;   // |reconstructed - target| per term
+  bool solved = false;             // false: the first stage met every term, or welded
+  bool bent = false;               // the Laplacian detail step ran
+  int free_directions = 0;         // affine directions kept from the first stage
+  std::string welded_to;           // non-empty for welded bones
+  Eigen::Affine3d affine;          // affine part of its placement (atlas -> patient)
+  double length_factor = 1.0;      // along its long axis (0 when it has none)
+  Eigen::Vector3d stretches;       // singular values of the affine's linear part, largest first
+  std::vector<std::string> terms;  // point terms used, in order
+  std::vector<double> term_residual_mm;  // |reconstructed - target| per term
 };
 
 struct MuscleScaling {

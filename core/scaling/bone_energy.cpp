@@ -99,7 +99,8 @@ BoneSolution solve_bone(const mesh::IndexedMesh& rest, const Eigen::Affine3d& pr
   for (int i = 0; i < 4; ++i) {
     const double lambda = eigen.eigenvalues()[i];
     if (lambda > options.determined_fraction * largest && lambda > 0.0) {
-      fitted_inverse += eigen.eigenvectors().col(i) * eigen.eigenvectors().col(i).transpose() / lambda;
+      fitted_inverse +=
+          eigen.eigenvectors().col(i) * eigen.eigenvectors().col(i).transpose() / lambda;
     } else {
       ++solution.free_directions;
     }
@@ -146,7 +147,8 @@ BoneSolution solve_bone(const mesh::IndexedMesh& rest, const Eigen::Affine3d& pr
   }
   const Eigen::MatrixX3d misfit = targets - A * solution.vertices;
   for (int k = 0; k < 3; ++k) {
-    solution.vertices.col(k) += factor.solve(VectorXd(A.transpose() * (w.asDiagonal() * misfit.col(k))));
+    solution.vertices.col(k) +=
+        factor.solve(VectorXd(A.transpose() * (w.asDiagonal() * misfit.col(k))));
   }
   if (!solution.vertices.allFinite()) {
     throw SolverError("bone energy: the solution is not finite (degenerate point terms?)");

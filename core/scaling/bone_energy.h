@@ -40,9 +40,9 @@
 namespace mmm::scaling {
 
 struct BoneEnergyOptions {
-  double laplacian_weight = 1.0;        // w_L
-  double determined_fraction = 1e-3;    // see step 1
-  double gauge_weight = 1e-4;           // w_d, relative to the mean diagonal of w_L L^T L
+  double laplacian_weight = 1.0;      // w_L
+  double determined_fraction = 1e-3;  // see step 1
+  double gauge_weight = 1e-4;         // w_d, relative to the mean diagonal of w_L L^T L
   double closed_form_tolerance_mm = 1e-6;
 };
 

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <utility>
 #include <optional>
 #include <set>
+#include <utility>
 
 #include "core/errors.h"
 #include "core/mesh/aabb_tree.h"
@@ -135,7 +135,8 @@ PreparedMuscle prepare_muscle(const std::string& name, const mesh::IndexedMesh& 
     if (best_bone >= 0 && best <= options.contact_distance_mm) {
       muscle.attached.push_back(static_cast<int>(i));
       muscle.attached_bone.push_back(best_bone);
-      muscle.attached_anchor.push_back(bones[static_cast<std::size_t>(best_bone)].anchors->anchor(p));
+      muscle.attached_anchor.push_back(
+          bones[static_cast<std::size_t>(best_bone)].anchors->anchor(p));
     }
   }
 
@@ -160,8 +161,8 @@ PreparedMuscle prepare_muscle(const std::string& name, const mesh::IndexedMesh& 
 MuscleSolution solve_muscle(const PreparedMuscle& muscle, const std::vector<ScaledBone>& bones,
                             const MuscleEnergyOptions& options) {
   if (static_cast<Eigen::Index>(bones.size()) != muscle.blend.cols()) {
-    throw InvalidInputError("muscle energy '" + muscle.name + "': " +
-                            std::to_string(bones.size()) + " scaled bones given, prepared with " +
+    throw InvalidInputError("muscle energy '" + muscle.name + "': " + std::to_string(bones.size()) +
+                            " scaled bones given, prepared with " +
                             std::to_string(muscle.blend.cols()));
   }
   const Eigen::Index n = muscle.rest.rows();
@@ -176,26 +177,29 @@ MuscleSolution solve_muscle(const PreparedMuscle& muscle, const std::vector<Scal
   Eigen::MatrixX3d attached_rhs = Eigen::MatrixX3d::Zero(n, 3);
   MuscleSolution solution;
   solution.attached_vertices = static_cast<int>(muscle.attached.size());
-  solution.band_vertices = static_cast<int>(
-      std::set<int>(muscle.band.begin(), muscle.band.end()).size());
+  solution.band_vertices =
+      static_cast<int>(std::set<int>(muscle.band.begin(), muscle.band.end()).size());
   double attached_sq = 0.0;
   for (std::size_t a = 0; a < muscle.attached.size(); ++a) {
     const int i = muscle.attached[a];
-    const Vector3d target = reconstruct(
-        muscle.attached_anchor[a],
-        *bones[static_cast<std::size_t>(muscle.attached_bone[a])].vertices);
-    attached_rhs.row(i) = options.attachment_weight * (target - start.row(i).transpose()).transpose();
+    const Vector3d target =
+        reconstruct(muscle.attached_anchor[a],
+                    *bones[static_cast<std::size_t>(muscle.attached_bone[a])].vertices);
+    attached_rhs.row(i) =
+        options.attachment_weight * (target - start.row(i).transpose()).transpose();
   }
   std::vector<double> bone_scale;
   for (const ScaledBone& bone : bones) {
     bone_scale.push_back(std::cbrt(std::abs(bone.affine->linear().determinant())));
   }
   // Band targets, as offsets from X1 (0 until a vertex must be pushed out).
-  Eigen::MatrixX3d band_offset = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(muscle.band.size()), 3);
+  Eigen::MatrixX3d band_offset =
+      Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(muscle.band.size()), 3);
   for (int iteration = 0;; ++iteration) {
     Eigen::MatrixX3d rhs = attached_rhs;
     for (std::size_t k = 0; k < muscle.band.size(); ++k) {
-      rhs.row(muscle.band[k]) += options.band_weight * band_offset.row(static_cast<Eigen::Index>(k));
+      rhs.row(muscle.band[k]) +=
+          options.band_weight * band_offset.row(static_cast<Eigen::Index>(k));
     }
     solution.vertices = start;
     for (int c = 0; c < 3; ++c) {
@@ -209,8 +213,8 @@ MuscleSolution solve_muscle(const PreparedMuscle& muscle, const std::vector<Scal
           *bones[static_cast<std::size_t>(muscle.band_bone[k])].distance;
       const Vector3d x = solution.vertices.row(i).transpose();
       const double sd = bone.at(x);
-      const double excess =
-          excess_depth(sd, muscle.band_rest_distance[k], bone_scale[static_cast<std::size_t>(muscle.band_bone[k])]);
+      const double excess = excess_depth(sd, muscle.band_rest_distance[k],
+                                         bone_scale[static_cast<std::size_t>(muscle.band_bone[k])]);
       if (excess <= options.penetration_tolerance_mm) continue;
       ++penetrating;
       worst = std::max(worst, excess);
@@ -231,8 +235,8 @@ MuscleSolution solve_muscle(const PreparedMuscle& muscle, const std::vector<Scal
   }
   for (std::size_t a = 0; a < muscle.attached.size(); ++a) {
     const int i = muscle.attached[a];
-    const Vector3d target = start.row(i).transpose() +
-                            attached_rhs.row(i).transpose() / options.attachment_weight;
+    const Vector3d target =
+        start.row(i).transpose() + attached_rhs.row(i).transpose() / options.attachment_weight;
     attached_sq += (solution.vertices.row(i).transpose() - target).squaredNorm();
   }
   if (!muscle.attached.empty()) {

@@ -61,24 +61,24 @@ struct MuscleEnergyOptions {
 // A bone as the muscles see it: rest surfaces for blend weights and contact.
 struct BoneAtRest {
   std::string name;
-  const mesh::IndexedMesh* full = nullptr;    // contact, attachment anchors
-  const mesh::IndexedMesh* coarse = nullptr;  // blend distances (the coarsest level)
-  const AnchorBuilder* anchors = nullptr;     // on `full`
+  const mesh::IndexedMesh* full = nullptr;         // contact, attachment anchors
+  const mesh::IndexedMesh* coarse = nullptr;       // blend distances (the coarsest level)
+  const AnchorBuilder* anchors = nullptr;          // on `full`
   const mesh::SignedDistance* distance = nullptr;  // of `full`
 };
 
 // Everything about a muscle that does not depend on the patient.
 struct PreparedMuscle {
   std::string name;
-  Eigen::MatrixX3d rest;    // full-resolution vertices at rest
+  Eigen::MatrixX3d rest;  // full-resolution vertices at rest
   Eigen::MatrixX3i faces;
-  Eigen::MatrixXd blend;    // #V x #bones, rows sum to 1 (bones in the order given)
-  std::vector<int> attached;                // vertex rows
-  std::vector<int> attached_bone;           // index into the bones
+  Eigen::MatrixXd blend;           // #V x #bones, rows sum to 1 (bones in the order given)
+  std::vector<int> attached;       // vertex rows
+  std::vector<int> attached_bone;  // index into the bones
   std::vector<AffineAnchor> attached_anchor;
   // Band: one entry per (vertex, bone) pair closer than band_mm at rest; a
   // vertex near two bones is tested against both.
-  std::vector<int> band;                    // vertex rows
+  std::vector<int> band;  // vertex rows
   std::vector<int> band_bone;
   std::vector<double> band_rest_distance;  // signed distance at rest (mm; < 0 inside)
   double rest_volume_mm3 = 0.0;
@@ -93,15 +93,15 @@ PreparedMuscle prepare_muscle(const std::string& name, const mesh::IndexedMesh& 
 
 // The scaled bones, in the order given to prepare_muscle.
 struct ScaledBone {
-  const Eigen::Affine3d* affine = nullptr;           // its affine part
-  const Eigen::MatrixX3d* vertices = nullptr;        // its placed full surface
-  const mesh::SignedDistance* distance = nullptr;    // of the placed full surface
+  const Eigen::Affine3d* affine = nullptr;         // its affine part
+  const Eigen::MatrixX3d* vertices = nullptr;      // its placed full surface
+  const mesh::SignedDistance* distance = nullptr;  // of the placed full surface
 };
 
 struct MuscleSolution {
   Eigen::MatrixX3d vertices;
-  double volume_ratio = 1.0;            // scaled / rest volume
-  int penetration_iterations = 0;       // solves after the first
+  double volume_ratio = 1.0;       // scaled / rest volume
+  int penetration_iterations = 0;  // solves after the first
   // Band vertices deeper in their bone than at rest (by more than the
   // tolerance), and the largest such excess depth (mm), before and after.
   int penetrating_before = 0;

@@ -23,7 +23,8 @@ ToyLeg toy_leg() {
   atlas::Atlas& a = leg.atlas;
   a.name = "toy_leg";
   const Vector3d hip(80, 0, -50), knee(85, 10, -450), ankle(70, 0, -830);
-  const auto add_bone = [&](const std::string& name, const Vector3d& centre, const Vector3d& radii) {
+  const auto add_bone = [&](const std::string& name, const Vector3d& centre,
+                            const Vector3d& radii) {
     atlas::Bone bone;
     bone.name = name;
     bone.frame.translation() = centre;
@@ -63,8 +64,8 @@ ToyLeg toy_leg() {
       joint("hip_r", "pelvis", "femur_r", hip, atlas::JointType::kBall,
             {"hip_flexion_r", "hip_adduction_r", "hip_rotation_r"}),
       joint("knee_r", "femur_r", "tibia_r", knee, atlas::JointType::kPin, {"knee_angle_r"}),
-      joint("patella_weld", "tibia_r", "patella_r", Vector3d(88, 45, -440),
-            atlas::JointType::kWeld, {}),
+      joint("patella_weld", "tibia_r", "patella_r", Vector3d(88, 45, -440), atlas::JointType::kWeld,
+            {}),
       joint("ankle_r", "tibia_r", "talus_r", ankle, atlas::JointType::kPin, {"ankle_angle_r"})};
   const auto landmark = [](const std::string& name, const std::string& bone, const Vector3d& p) {
     atlas::Landmark l;
@@ -124,7 +125,6 @@ ToyLeg toy_leg() {
   }
   return leg;
 }
-
 
 void write_toy_leg(const std::filesystem::path& dir) {
   const ToyLeg leg = toy_leg();

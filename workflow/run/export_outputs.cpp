@@ -82,7 +82,8 @@ std::string sniffed_extension(const std::filesystem::path& blob) {
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
   if (head.starts_with("\x89PNG\r\n\x1a\n")) return ".png";
-  if (head.starts_with("<svg") || (head.starts_with("<?xml") && head.find("<svg") != std::string::npos)) {
+  if (head.starts_with("<svg") ||
+      (head.starts_with("<?xml") && head.find("<svg") != std::string::npos)) {
     return ".svg";
   }
   if (head.starts_with("%PDF")) return ".pdf";

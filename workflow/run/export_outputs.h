@@ -1,12 +1,11 @@
 #pragma once
 // The workflow's exported outputs, copied from the artifact store into
 // DIR/outputs/<name><extension> for people and other tools (ParaView opens
-// the .ply, a spreadsheet the .json/.csv, an atlas folder its atlas.yaml). Each file is written to a
-// temporary name, flushed and renamed, so outputs/ never holds a partial
-// file; a file whose content is already current is left alone. An output
-// whose node has no current result (failed, waiting, blocked) has its old
-// file removed, so outputs/ never shows a result that does not match the
-// study's current inputs and parameters.
+// the .ply, a spreadsheet the .json/.csv, an atlas folder its atlas.yaml). Each file is written to
+// a temporary name, flushed and renamed, so outputs/ never holds a partial file; a file whose
+// content is already current is left alone. An output whose node has no current result (failed,
+// waiting, blocked) has its old file removed, so outputs/ never shows a result that does not match
+// the study's current inputs and parameters.
 
 #include <filesystem>
 #include <map>

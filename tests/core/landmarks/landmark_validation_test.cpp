@@ -323,8 +323,8 @@ TEST(LandmarkValidationTest, TheOtherSidesAsisBelongsOnTheOtherSide) {
                                          {"asis_l", asis_r}}),
                           rules);
   EXPECT_THAT(swapped.reasons, Contains(HasSubstr("a landmark of the other side must lie at least "
-                                            "10.0 mm to the subject's left (the two sides "
-                                            "swapped?)")))
+                                                  "10.0 mm to the subject's left (the two sides "
+                                                  "swapped?)")))
       << ::testing::PrintToString(swapped.reasons);
 }
 

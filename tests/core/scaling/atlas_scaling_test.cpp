@@ -8,9 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
-#include <algorithm>
 #include <numbers>
 
 #include "core/errors.h"
@@ -51,10 +51,10 @@ TEST(AffineAnchorTest, ReconstructsAffinelyMappedPointsOnNearAndFarFromTheSurfac
   const AnchorBuilder builder(surface.V);
   const Affine3d map = skewed_affine();
   const Eigen::MatrixX3d moved = mapped(map, surface.V);
-  for (const Vector3d& point : {Vector3d(surface.V.row(10).transpose()),
-                                Vector3d(25.5, -3, 40),      // just outside
-                                Vector3d(5, -3, 40),         // the centre
-                                Vector3d(60, 50, 150)}) {    // far away
+  for (const Vector3d& point :
+       {Vector3d(surface.V.row(10).transpose()), Vector3d(25.5, -3, 40),  // just outside
+        Vector3d(5, -3, 40),                                              // the centre
+        Vector3d(60, 50, 150)}) {                                         // far away
     const AffineAnchor anchor = builder.anchor(point);
     double sum = 0;
     for (const double w : anchor.weights) sum += w;
@@ -70,8 +70,8 @@ std::vector<PointTerm> terms_for(const mesh::IndexedMesh& bone, const std::vecto
   const AnchorBuilder builder(bone.V);
   std::vector<PointTerm> terms;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    terms.push_back({"p" + std::to_string(i), builder.anchor(points[i]), points[i], to * points[i],
-                     100.0});
+    terms.push_back(
+        {"p" + std::to_string(i), builder.anchor(points[i]), points[i], to * points[i], 100.0});
   }
   return terms;
 }
@@ -100,10 +100,10 @@ TEST(BoneEnergyTest, DirectionsTheLandmarksLeaveOpenKeepThePrior) {
   const Affine3d truth = skewed_affine();
   // Three landmarks and a fourth 0.5 mm from the first: a plane, whose
   // normal direction the near pair must not decide.
-  const std::vector<PointTerm> terms = terms_for(
-      bone, {Vector3d(25, 0, -200), Vector3d(-25, 0, -150), Vector3d(0, 0, -390),
-             Vector3d(25, 0.5, -200)},
-      truth);
+  const std::vector<PointTerm> terms = terms_for(bone,
+                                                 {Vector3d(25, 0, -200), Vector3d(-25, 0, -150),
+                                                  Vector3d(0, 0, -390), Vector3d(25, 0.5, -200)},
+                                                 truth);
   Affine3d skewed_prior = truth;
   skewed_prior.linear() *= 1.02;
   const BoneSolution from_skewed = solve_bone(bone, skewed_prior, terms);
@@ -239,7 +239,6 @@ TEST(MuscleEnergyTest, AMuscleTheBlendWouldPushIntoABoneComesOutOfIt) {
   EXPECT_NEAR(after.volume_ratio, before.volume_ratio, 0.05);
 }
 
-
 landmarks::LandmarkSet station_landmarks(const atlas::Atlas& a, const Affine3d& map) {
   landmarks::LandmarkSet set;
   for (const char* name : {"femoral_head_centre_r", "patella_centre_r", "ankle_centre_r"}) {
@@ -269,7 +268,8 @@ TEST(AtlasScalingTest, AKnownSimilarityCarriesEveryElementExactly) {
       EXPECT_EQ(scaled.meshes.at(element).at(level).F, surface.F);
     }
   }
-  for (const auto& [name, residual] : scaled.landmark_residual_mm) EXPECT_LT(residual, kExact) << name;
+  for (const auto& [name, residual] : scaled.landmark_residual_mm)
+    EXPECT_LT(residual, kExact) << name;
   const atlas::Atlas& out = scaled.atlas;
   EXPECT_LT((out.landmarks[3].position - map * leg.atlas.landmarks[3].position).norm(), kExact);
   EXPECT_LT((out.markers[0].position - map * leg.atlas.markers[0].position).norm(), kExact);
@@ -279,9 +279,9 @@ TEST(AtlasScalingTest, AKnownSimilarityCarriesEveryElementExactly) {
                   .norm(),
               kExact);
   }
-  EXPECT_LT((out.muscles[0].origins[0].centroid - map * leg.atlas.muscles[0].origins[0].centroid)
-                .norm(),
-            kExact);
+  EXPECT_LT(
+      (out.muscles[0].origins[0].centroid - map * leg.atlas.muscles[0].origins[0].centroid).norm(),
+      kExact);
   const atlas::WrapObstacle& wrap = out.muscles[0].wrap_obstacles[0];
   EXPECT_LT((wrap.pose.translation() - map * Vector3d(85, 10, -430)).norm(), kExact);
   EXPECT_NEAR(wrap.radii.x(), 20 * 1.07, 1e-9);
@@ -317,8 +317,7 @@ TEST(AtlasScalingTest, AFurtherLandmarkBendsItsBoneOntoIt) {
   ASSERT_NE(femur, scaled.bones.end());
   EXPECT_TRUE(femur->solved);
   // The chain stays connected: the tibia hangs where the femur puts the knee.
-  const Vector3d knee_on_femur =
-      scaled.atlas.joints[1].parent_frame.translation();
+  const Vector3d knee_on_femur = scaled.atlas.joints[1].parent_frame.translation();
   const Vector3d knee_on_tibia = scaled.atlas.joints[1].child_frame.translation();
   EXPECT_LT((knee_on_femur - knee_on_tibia).norm(), 0.5);
 }
