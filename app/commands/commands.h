@@ -22,6 +22,9 @@ void register_atlas_commands(CLI::App& app);
 // mmm patient synth
 void register_patient_commands(CLI::App& app);
 
+// mmm overlay: atlas bones outlined over a radiograph pair
+void register_overlay_commands(CLI::App& app);
+
 // mmm study create|set, mmm run, mmm status, mmm explain
 void register_study_commands(CLI::App& app, const workflow::NodeRegistry& registry);
 
