@@ -11,7 +11,6 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -242,6 +241,12 @@ nlohmann::json to_json(const Accuracy& a) {
           {"per_bone_mean_mm", a.per_bone_mean_mm}};
 }
 
+std::string fixed(double value, int decimals) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(decimals) << value;
+  return text.str();
+}
+
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const std::size_t n = values.size();
@@ -279,16 +284,13 @@ nlohmann::json real_data_check(std::ostream& out) {
   const double shank = (at("ankle_centre_r") - at("knee_centre_r")).norm();
   const double femur = thigh / femur_mm;
   const double tibia = shank / tibia_mm;
-  char line[256];
-  out << "\nreal data: subject01_static.trc landmarks vs OpenSim's scale set (gait2392 generic)\n";
-  std::snprintf(line, sizeof line,
-                "  femur_r: hip-knee %.1f mm / generic %.1f mm = %.3f (OpenSim 1.147, %+.1f%%)\n",
-                thigh, femur_mm, femur, 100.0 * (femur / 1.14724 - 1.0));
-  out << line;
-  std::snprintf(line, sizeof line,
-                "  tibia_r: knee-ankle %.1f mm / generic %.1f mm = %.3f (OpenSim 0.989, %+.1f%%)\n",
-                shank, tibia_mm, tibia, 100.0 * (tibia / 0.988523 - 1.0));
-  out << line;
+  out << "\nreal data: subject01_static.trc landmarks vs OpenSim's scale set (gait2392 generic)\n"
+      << "  femur_r: hip-knee " << fixed(thigh, 1) << " mm / generic " << fixed(femur_mm, 1)
+      << " mm = " << fixed(femur, 3) << " (OpenSim 1.147, "
+      << fixed(100.0 * (femur / 1.14724 - 1.0), 1) << " %)\n"
+      << "  tibia_r: knee-ankle " << fixed(shank, 1) << " mm / generic " << fixed(tibia_mm, 1)
+      << " mm = " << fixed(tibia, 3) << " (OpenSim 0.989, "
+      << fixed(100.0 * (tibia / 0.988523 - 1.0), 1) << " %)\n";
   return {{"femur_r", {{"ours", femur}, {"opensim", 1.14724}, {"thigh_mm", thigh}}},
           {"tibia_r", {{"ours", tibia}, {"opensim", 0.988523}, {"shank_mm", shank}}}};
 }
@@ -314,6 +316,7 @@ void accuracy_table(std::ostream& out) {
       {"ours: station + bony", plus(kStation, kBony), true},
       {"uniform baseline (H,P,A)", kStation, false}};
   std::vector<std::string> methods;
+  methods.reserve(method_list.size());
   for (const Method& method : method_list) methods.push_back(method.name);
   std::map<std::string, std::vector<Accuracy>> results;
   nlohmann::json per_patient = nlohmann::json::array();
@@ -362,7 +365,6 @@ void accuracy_table(std::ostream& out) {
       {"muscle worst p95 (mm)", &Accuracy::muscle_worst_p95_mm, ""},
       {"muscle volume vs truth, max |%|", &Accuracy::volume_max_percent, ""},
       {"new penetration, max (mm)", &Accuracy::penetration_max_mm, "<= 0.5"}};
-  char line[512];
   out << "\nscaling accuracy over " << patients
       << " synthetic patients (seeds 101.., statures 1500-2050 mm), exact landmarks;\n"
       << "each cell: median over patients / worst patient\n";
@@ -376,9 +378,7 @@ void accuracy_table(std::ostream& out) {
     for (const std::string& method : methods) {
       const double med = column(method, row.field, false);
       const double worst = column(method, row.field, true);
-      char cell[64];
-      std::snprintf(cell, sizeof cell, "%.3f / %.3f", med, worst);
-      out << " " << std::setw(24) << cell;
+      out << " " << std::setw(24) << fixed(med, 3) + " / " + fixed(worst, 3);
       entry[method] = {{"median", med}, {"worst", worst}};
     }
     out << " " << row.target << "\n";
@@ -390,8 +390,7 @@ void accuracy_table(std::ostream& out) {
     std::vector<double> values;
     for (const Accuracy& a : results[methods[0]])
       values.push_back(a.per_bone_mean_mm.at(bone.name));
-    std::snprintf(line, sizeof line, " %s %.2f", bone.name.c_str(), median(values));
-    out << line;
+    out << " " << bone.name << " " << fixed(median(values), 2);
   }
   out << "\n";
   nlohmann::json document = {{"table", table},
@@ -450,9 +449,14 @@ BENCHMARK(BM_ScaleWholeAtlasBony)->Unit(benchmark::kMillisecond)->Iterations(1);
 }  // namespace
 
 int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  if (std::getenv("MMM_BENCH_SKIP_ACCURACY") == nullptr) write_accuracy_table();
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
+  try {
+    benchmark::Initialize(&argc, argv);
+    if (std::getenv("MMM_BENCH_SKIP_ACCURACY") == nullptr) write_accuracy_table();
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+  } catch (const std::exception& error) {
+    std::cerr << "mmm_bench_scaling: " << error.what() << "\n";
+    return 1;
+  }
   return 0;
 }

@@ -31,6 +31,7 @@ void parallel_for(std::size_t count, int threads, const Job& job) {
   };
   std::vector<std::jthread> pool;
   const int extra = std::min<int>(std::max(1, threads), static_cast<int>(count)) - 1;
+  pool.reserve(static_cast<std::size_t>(std::max(0, extra)));
   for (int t = 0; t < extra; ++t) pool.emplace_back(work);
   work();
   pool.clear();

@@ -45,7 +45,7 @@ std::uint64_t spread_bits(std::uint64_t v) {
 std::vector<Eigen::Index> morton_order(const Eigen::MatrixX3d& V) {
   const Eigen::RowVector3d low = V.colwise().minCoeff();
   const double extent = std::max((V.colwise().maxCoeff() - low).maxCoeff(), 1e-9);
-  const double cells = static_cast<double>((1U << 21U) - 1U);
+  const auto cells = static_cast<double>((1U << 21U) - 1U);
   std::vector<std::pair<std::uint64_t, Eigen::Index>> keyed(static_cast<std::size_t>(V.rows()));
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     std::uint64_t code = 0;
@@ -189,6 +189,7 @@ MuscleSolution solve_muscle(const PreparedMuscle& muscle, const std::vector<Scal
         options.attachment_weight * (target - start.row(i).transpose()).transpose();
   }
   std::vector<double> bone_scale;
+  bone_scale.reserve(bones.size());
   for (const ScaledBone& bone : bones) {
     bone_scale.push_back(std::cbrt(std::abs(bone.affine->linear().determinant())));
   }
@@ -233,8 +234,7 @@ MuscleSolution solve_muscle(const PreparedMuscle& muscle, const std::vector<Scal
     solution.penetration_iterations = iteration;
     if (penetrating == 0 || iteration >= options.max_penetration_iterations) break;
   }
-  for (std::size_t a = 0; a < muscle.attached.size(); ++a) {
-    const int i = muscle.attached[a];
+  for (const int i : muscle.attached) {
     const Vector3d target =
         start.row(i).transpose() + attached_rhs.row(i).transpose() / options.attachment_weight;
     attached_sq += (solution.vertices.row(i).transpose() - target).squaredNorm();

@@ -300,8 +300,8 @@ namespace {
 TEST(LandmarkValidationTest, TheOtherSidesAsisBelongsOnTheOtherSide) {
   const auto views = leg_views();
   ValidationRules rules;
-  rules.required.push_back("asis_r");
-  rules.required.push_back("asis_l");
+  rules.required.emplace_back("asis_r");
+  rules.required.emplace_back("asis_l");
   rules.opposite_side = {"asis_l"};
   const Eigen::Vector3d asis_r(120, 60, 960);
   const Eigen::Vector3d asis_l(-120, 60, 960);

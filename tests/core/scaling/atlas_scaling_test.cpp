@@ -262,7 +262,7 @@ TEST(AtlasScalingTest, AKnownSimilarityCarriesEveryElementExactly) {
   constexpr double kExact = 1e-6;
   for (const auto& [element, levels] : leg.meshes) {
     for (const auto& [level, surface] : levels) {
-      SCOPED_TRACE(element + " " + level);
+      SCOPED_TRACE(::testing::Message() << element << " " << level);
       const Eigen::MatrixX3d& placed = scaled.meshes.at(element).at(level).V;
       EXPECT_LT((placed - mapped(map, surface.V)).rowwise().norm().maxCoeff(), kExact);
       EXPECT_EQ(scaled.meshes.at(element).at(level).F, surface.F);
