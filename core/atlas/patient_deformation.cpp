@@ -4,9 +4,9 @@
 #include <cmath>
 #include <deque>
 #include <numbers>
-#include <set>
 
 #include "core/atlas/bone_registration.h"
+#include "core/atlas/kinematic_chain.h"
 #include "core/errors.h"
 #include "core/mesh/aabb_tree.h"
 
@@ -30,49 +30,6 @@ Eigen::Isometry3d map_frame(const Eigen::Affine3d& map, const Eigen::Isometry3d&
 
 double length_scale(const Eigen::Affine3d& map) {
   return std::cbrt(std::abs(map.linear().determinant()));
-}
-
-const Joint* joint_to(const Atlas& atlas, const std::string& child) {
-  for (const Joint& joint : atlas.joints) {
-    if (joint.child == child) return &joint;
-  }
-  return nullptr;
-}
-
-// Bones in an order where each comes after its parent; the root first.
-std::vector<const Bone*> chain_order(const Atlas& atlas, const Bone*& root) {
-  root = nullptr;
-  for (const Bone& bone : atlas.bones) {
-    if (joint_to(atlas, bone.name) == nullptr) {
-      root = &bone;
-      break;
-    }
-  }
-  if (root == nullptr) {
-    throw InvalidInputError(
-        "patient deformation: the atlas has no root bone (every bone hangs "
-        "from a joint)");
-  }
-  std::vector<const Bone*> order{root};
-  std::set<std::string> placed{root->name};
-  bool progress = true;
-  while (progress) {
-    progress = false;
-    for (const Bone& bone : atlas.bones) {
-      if (placed.contains(bone.name)) continue;
-      const Joint* joint = joint_to(atlas, bone.name);
-      if (joint == nullptr || placed.contains(joint->parent)) {
-        order.push_back(&bone);
-        placed.insert(bone.name);
-        progress = true;
-      }
-    }
-  }
-  if (order.size() != atlas.bones.size()) {
-    throw InvalidInputError("patient deformation: some bones are not connected to the root '" +
-                            root->name + "' by joints");
-  }
-  return order;
 }
 
 opensim::Function scaled(const opensim::Function& function, double factor) {
@@ -153,8 +110,8 @@ PatientDeformation make_patient_deformation(const Atlas& atlas, const PatientOpt
   // seed's proportions as they were. draw() gives 1 + sd z (z clipped).
   factors.neck_angle_deg = (draw(random, options.neck_angle_sd_deg / 100.0) - 1.0) * 100.0;
 
-  const Bone* root = nullptr;
-  const std::vector<const Bone*> order = chain_order(atlas, root);
+  const std::vector<const Bone*> order = chain_order(atlas, "patient deformation");
+  const Bone* root = order.front();
   deformation.neck = neck_warp_for(atlas, *root);
   if (!deformation.neck.bone.empty()) {
     NeckWarp& neck = deformation.neck;
@@ -176,19 +133,12 @@ PatientDeformation make_patient_deformation(const Atlas& atlas, const PatientOpt
       map = deformation.bone_maps.at(joint->parent);
     } else {
       const Eigen::Vector3d proximal = joint->child_frame.translation();
-      Eigen::Vector3d distal = Eigen::Vector3d::Zero();
-      int distal_count = 0;
-      for (const Joint& child : atlas.joints) {
-        if (child.parent == bone->name && child.type != JointType::kWeld) {
-          distal += child.child_frame.translation();
-          ++distal_count;
-        }
-      }
+      const std::optional<Eigen::Vector3d> distal = distal_joint_centre(atlas, bone->name);
       const double length = factors.length.at(bone->name);
       const double width = factors.width.at(bone->name);
       Eigen::Matrix3d linear = s * length * Eigen::Matrix3d::Identity();
-      if (distal_count > 0 && (distal / distal_count - proximal).norm() > 1.0) {
-        const Eigen::Vector3d axis = (distal / distal_count - proximal).normalized();
+      if (distal && (*distal - proximal).norm() > 1.0) {
+        const Eigen::Vector3d axis = (*distal - proximal).normalized();
         const Eigen::Matrix3d along = axis * axis.transpose();
         linear = s * (length * along + width * (Eigen::Matrix3d::Identity() - along));
       }

@@ -2,9 +2,9 @@
 
 #include <Eigen/Dense>
 #include <chrono>
-#include <set>
 
 #include "core/atlas/bone_registration.h"
+#include "core/atlas/kinematic_chain.h"
 #include "core/errors.h"
 #include "core/mesh/mass_properties.h"
 #include "core/parallel_for.h"
@@ -32,59 +32,9 @@ const mesh::IndexedMesh& coarsest_mesh(const atlas::AtlasMeshes& meshes, const a
   return meshes.at(bone.name).at(bone.meshes.back().level);
 }
 
-const atlas::Joint* joint_to(const atlas::Atlas& atlas, const std::string& child) {
-  for (const atlas::Joint& joint : atlas.joints) {
-    if (joint.child == child) return &joint;
-  }
-  return nullptr;
-}
-
-// Bones root first, each after its parent.
-std::vector<const atlas::Bone*> chain_order(const atlas::Atlas& atlas) {
-  std::vector<const atlas::Bone*> order;
-  std::set<std::string> placed;
-  for (bool progress = true; progress;) {
-    progress = false;
-    for (const atlas::Bone& bone : atlas.bones) {
-      if (placed.contains(bone.name)) continue;
-      const atlas::Joint* joint = joint_to(atlas, bone.name);
-      if (joint == nullptr || placed.contains(joint->parent)) {
-        order.push_back(&bone);
-        placed.insert(bone.name);
-        progress = true;
-      }
-    }
-  }
-  if (order.size() != atlas.bones.size()) {
-    throw InvalidInputError("atlas scaling: some bones are not connected to the root by joints");
-  }
-  return order;
-}
-
-// The bone whose placement `bone` follows: itself, or the bone at the end
-// of its chain of weld joints.
-std::string moving_with(const atlas::Atlas& atlas, std::string bone) {
-  for (std::size_t guard = 0; guard <= atlas.joints.size(); ++guard) {
-    const atlas::Joint* joint = joint_to(atlas, bone);
-    if (joint == nullptr || joint->type != atlas::JointType::kWeld) return bone;
-    bone = joint->parent;
-  }
-  return bone;
-}
-
-// Centre of a bone's distal joints (their child frames), for its long axis.
-std::optional<Vector3d> distal_centre(const atlas::Atlas& atlas, const std::string& bone) {
-  Vector3d sum = Vector3d::Zero();
-  int count = 0;
-  for (const atlas::Joint& joint : atlas.joints) {
-    if (joint.parent == bone && joint.type != atlas::JointType::kWeld) {
-      sum += joint.child_frame.translation();
-      ++count;
-    }
-  }
-  if (count == 0) return std::nullopt;
-  return sum / count;
-}
+using atlas::chain_order;
+using atlas::joint_to;
+using atlas::moving_with;
 
 Eigen::MatrixX3d reconstruct_all(const std::vector<AffineAnchor>& anchors,
                                  const Eigen::MatrixX3d& vertices) {
@@ -217,7 +167,7 @@ BoneScaling describe_bone(const atlas::Atlas& a, const atlas::Bone& bone, const 
                                                              affine.linear());
   out.stretches = eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().reverse();
   const atlas::Joint* joint = joint_to(a, bone.name);
-  const std::optional<Vector3d> distal = distal_centre(a, bone.name);
+  const std::optional<Vector3d> distal = atlas::distal_joint_centre(a, bone.name);
   if (joint != nullptr && distal && (*distal - joint->child_frame.translation()).norm() > 1.0) {
     const Vector3d axis = (*distal - joint->child_frame.translation()).normalized();
     out.length_factor = (affine.linear() * axis).norm();
@@ -304,7 +254,7 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
   // Bones, root first.
   Clock::time_point stage = Clock::now();
   PlacedBones placed;
-  for (const atlas::Bone* bone : chain_order(a)) {
+  for (const atlas::Bone* bone : chain_order(a, "atlas scaling")) {
     const atlas::Joint* joint = joint_to(a, bone->name);
     const mesh::IndexedMesh& rest = full_mesh(prepared.meshes, bone->name);
     BoneScaling report;

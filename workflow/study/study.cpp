@@ -81,7 +81,7 @@ std::optional<FileStamp> stamp_of(const std::filesystem::path& origin, PortType 
 }
 
 // What to write after --input NAME= in hints.
-std::string input_placeholder(PortType type) {
+std::string input_value_hint(PortType type) {
   if (is_value_type(type)) return "VALUE";
   return accepts_folder(type) ? "DIR" : "PATH";
 }
@@ -188,7 +188,7 @@ Study Study::create(const std::filesystem::path& dir, const CreateStudyOptions& 
     if (!options.inputs.contains(input.name) && !input.default_value) {
       problems.push_back("study input '" + input.name + "' (" + input.type_name +
                          ") has no default: give it with --input " + input.name + "=" +
-                         input_placeholder(*input.type));
+                         input_value_hint(*input.type));
     }
   }
   if (!problems.empty()) {
@@ -304,7 +304,7 @@ StudyInputRecord Study::import_input(const StudyInput& declared, std::string_vie
                            std::string(accepts_folder(record.type) ? "atlas folder (or of a "
                                                                      "packed bundle file)"
                                                                    : "file") +
-                           " with --input " + declared.name + "=" + input_placeholder(record.type);
+                           " with --input " + declared.name + "=" + input_value_hint(record.type);
   if (!stamp) {
     throw IoError(origin,
                   what +
