@@ -58,12 +58,13 @@ TrackingSetup bind_tracking(const Skeleton& skeleton, const MarkerMapping& mappi
       ++on_root;
     }
   }
-  if (on_root < 3 && (on_root > 0 || setup.markers.size() < 3)) {
+  if (on_root < 3) {
     const std::string root = skeleton.bodies.empty() ? "(none)" : skeleton.bodies.front().name;
     throw InvalidInputError(
         mapping.source.string() + ": only " + std::to_string(on_root) + " tracked marker(s) on '" +
         root + "' and " + std::to_string(setup.markers.size()) +
-        " in all; at least 3 on the root are needed to place it (mapped but not in the trial: " +
+        " in all; at least 3 on the root are needed to place it (check the mapping's model names; "
+        "mapped but not in the trial: " +
         join_names(setup.not_in_trial) + "; not on the model: " + join_names(setup.not_on_model) +
         ")");
   }

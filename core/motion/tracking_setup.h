@@ -36,9 +36,9 @@ struct TrackingSetup {
 };
 
 // Binds `mapping` to `skeleton` and the trial's marker names. Throws
-// InvalidInputError, naming the mapping file, when fewer than 3 markers of
-// the skeleton's root body (or, without any there, fewer than 3 markers in
-// all) can be tracked: the root's six degrees of freedom would be free.
+// InvalidInputError, naming the mapping file and the skipped names, when
+// fewer than 3 markers of the skeleton's root body can be tracked: its six
+// degrees of freedom would be free.
 TrackingSetup bind_tracking(const Skeleton& skeleton, const MarkerMapping& mapping,
                             const std::vector<std::string>& trial_markers);
 
