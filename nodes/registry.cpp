@@ -6,6 +6,7 @@
 #include "nodes/load_mesh.h"
 #include "nodes/load_radiographs.h"
 #include "nodes/measure_mesh.h"
+#include "nodes/fuse_motion.h"
 #include "nodes/scale_atlas.h"
 #include "nodes/static_trial_landmarks.h"
 #include "worklists/landmark_task.h"
@@ -23,6 +24,7 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<ImportMarkups>();
   registry.add<StaticTrialLandmarks>();
   registry.add<ScaleAtlas>();
+  registry.add<FuseMotion>();
   return registry;
 }
 

@@ -54,9 +54,10 @@ void copy_atomically(const std::filesystem::path& blob, const std::filesystem::p
   sync_path(target.parent_path(), O_RDONLY | O_DIRECTORY);
 }
 
-// An Atlas export is also unpacked beside its bundle, as the folder people
-// and tools open (atlas.yaml + meshes/): into a temporary folder first, then
-// swapped in, so the folder is always one whole atlas.
+// An Atlas export (or a File holding a folder bundle) is also unpacked
+// beside its bundle, as the folder people and tools open (atlas.yaml +
+// meshes/, motion.pvd + frames): into a temporary folder first, then swapped
+// in, so the folder is always whole.
 void unpack_atlas_atomically(const std::string& bundle, const std::filesystem::path& target) {
   const std::filesystem::path temporary =
       target.parent_path() / ("." + target.filename().string() + ".tmp");
@@ -87,6 +88,7 @@ std::string sniffed_extension(const std::filesystem::path& blob) {
     return ".svg";
   }
   if (head.starts_with("%PDF")) return ".pdf";
+  if (head.starts_with("mmm-bundle 1\n")) return ".bundle";  // a folder (core/directory_bundle.h)
   return "";
 }
 
@@ -116,7 +118,8 @@ ExportReport export_outputs(
     if (artifact == nullptr) {
       if (previous == recorded.end()) continue;
       std::filesystem::remove(folder / previous->second.file, error);
-      if (previous->second.file.ends_with(port_type_info(PortType::kAtlas).extension)) {
+      if (previous->second.file.ends_with(port_type_info(PortType::kAtlas).extension) ||
+          previous->second.file.ends_with(".bundle")) {
         std::filesystem::remove_all(folder / output.name, error);
       }
       Transaction transaction(study.database());
@@ -131,7 +134,9 @@ ExportReport export_outputs(
     const std::filesystem::path blob = study.artifacts().path_of(artifact->hash);
     const std::string file = export_file_name(output.name, artifact->type, blob);
     const std::filesystem::path target = folder / file;
-    const bool atlas = artifact->type == PortType::kAtlas;
+    // Folder-shaped values (an atlas, a File holding a folder bundle such as
+    // an animation) are also unpacked into outputs/<name>/.
+    const bool atlas = artifact->type == PortType::kAtlas || file.ends_with(".bundle");
     if (previous != recorded.end() && previous->second.hash == artifact->hash &&
         previous->second.file == file && std::filesystem::is_regular_file(target, error) &&
         std::filesystem::file_size(target, error) == std::filesystem::file_size(blob, error) &&

@@ -1,0 +1,116 @@
+// Node fuse_motion: OpenSim's subject model driven by the real walking
+// trial agrees with OpenSim's IK and writes every output in a format its
+// tool opens; a patient's atlas gets the motion by retargeting; bad inputs
+// fail with a hint.
+
+#include <gtest/gtest.h>
+#include <tinyxml2.h>
+
+#include <nlohmann/json.hpp>
+
+#include "core/atlas/atlas_io.h"
+#include "core/directory_bundle.h"
+#include "core/errors.h"
+#include "core/mesh/io/pvd.h"
+#include "core/motion/motion_io.h"
+#include "core/opensim/mot.h"
+#include "nodes/fuse_motion.h"
+#include "tests/nodes/node_harness.h"
+#include "tests/support/test_data.h"
+#include "tests/support/toy_leg_atlas.h"
+
+namespace mmm::nodes {
+namespace {
+
+using workflow::PortType;
+
+std::filesystem::path pipelines() {
+  return mmm::test::data_dir() / "gait2392" / "Pipelines";
+}
+
+workflow::ArtifactRef add_file(test::NodeHarness& harness, const std::filesystem::path& file) {
+  return harness.add(PortType::kFile, mmm::test::read_text(file));
+}
+
+TEST(FuseMotionNodeTest, DrivesOpenSimsSubjectModelAsOpenSimDoes) {
+  test::NodeHarness harness;
+  const auto outputs = harness.run<FuseMotion>(
+      {{"model", add_file(harness, pipelines() / "reference" / "subject01_simbody.osim")},
+       {"trial", add_file(harness, pipelines() / "subject01_walk1.trc")},
+       {"reference", add_file(harness, pipelines() / "reference" / "subject01_walk1_ik.mot")}},
+      {{"start_time", 0.5}, {"end_time", 1.0}, {"filter", std::string("none")}});
+  const nlohmann::json report = nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+  EXPECT_EQ(report["fit"]["frames"], 31);  // 0.5-1.0 s at 60 Hz
+  int compared = 0;
+  for (const nlohmann::json& row : report["reference_comparison"]) {
+    const std::string coordinate = row["coordinate"];
+    if (coordinate == "knee_angle_r" || coordinate == "hip_flexion_r" ||
+        coordinate == "ankle_angle_r") {
+      // Same objective, same weights: OpenSim's answer to its accuracy
+      // (1e-5), far inside the 2 degrees.
+      EXPECT_LT(row["rms"].get<double>(), 0.1) << coordinate;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 3);
+  // The .mot reads back in degrees; the motion JSON reads back whole.
+  const opensim::StorageTable angles = opensim::read_mot(outputs.at("angles").path);
+  EXPECT_TRUE(angles.in_degrees);
+  EXPECT_EQ(angles.num_rows(), 31);
+  const motion::FusedMotion motion = motion::motion_from_json(
+      nlohmann::json::parse(mmm::test::read_text(outputs.at("motion").path)), "motion");
+  EXPECT_EQ(motion.body_names.size(), 12u);
+  EXPECT_EQ(motion.poses.size(), 31u);
+  // The plot is an SVG document; the animation a ParaView series.
+  tinyxml2::XMLDocument svg;
+  ASSERT_EQ(svg.LoadFile(outputs.at("plot").path.c_str()), tinyxml2::XML_SUCCESS);
+  EXPECT_STREQ(svg.RootElement()->Name(), "svg");
+  const std::filesystem::path animation = harness.folder() / "animation";
+  unpack_directory(mmm::test::read_text(outputs.at("animation").path), animation, "animation");
+  const std::vector<mesh::PvdEntry> entries = mesh::read_pvd(animation / "motion.pvd");
+  EXPECT_EQ(entries.size(), 31u);  // the stick figure, per frame
+  const std::string points = mmm::test::read_text(outputs.at("points").path);
+  EXPECT_TRUE(points.starts_with("frame,time_s,kind,element,name,bone,x_mm,y_mm,z_mm,active\n"));
+}
+
+TEST(FuseMotionNodeTest, RetargetsTheSubjectsMotionToAPatientAtlas) {
+  test::NodeHarness harness;
+  mmm::test::ToyLeg leg = mmm::test::toy_leg();
+  // Three pelvis markers so that the patient can be measured against the trial.
+  for (const auto& [name, x] : {std::pair{"R.ASIS", 150.0}, {"L.ASIS", -60.0}}) {
+    leg.atlas.markers.push_back({name, "pelvis", Eigen::Vector3d(x, 30, 20), true});
+  }
+  leg.atlas.markers.push_back({"V.Sacral", "pelvis", Eigen::Vector3d(45, -120, 30), true});
+  atlas::write_atlas_with_meshes(leg.atlas, leg.meshes, harness.folder() / "toy");
+  const auto outputs = harness.run<FuseMotion>(
+      {{"atlas", harness.add(PortType::kAtlas, pack_directory(harness.folder() / "toy"))},
+       {"model", add_file(harness, pipelines() / "reference" / "subject01_simbody.osim")},
+       {"trial", add_file(harness, pipelines() / "subject01_walk1.trc")}},
+      {{"start_time", 0.5}, {"end_time", 0.7}, {"mesh_level", std::string("lod1")}});
+  const nlohmann::json report = nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+  ASSERT_TRUE(report.contains("retargeting"));
+  const std::vector<std::string> transferred = report["retargeting"]["transferred"];
+  EXPECT_NE(std::find(transferred.begin(), transferred.end(), "knee_angle_r"), transferred.end());
+  EXPECT_GT(report["retargeting"]["leg_length_ratio"].get<double>(), 0.5);
+  // The patient's bones, action lines and stick figure per frame.
+  const std::filesystem::path animation = harness.folder() / "animation";
+  unpack_directory(mmm::test::read_text(outputs.at("animation").path), animation, "animation");
+  EXPECT_TRUE(std::filesystem::exists(animation / "motion" / "femur_r_0000.vtp"));
+  EXPECT_TRUE(std::filesystem::exists(animation / "motion" / "action_lines_0000.vtp"));
+  const std::string points = mmm::test::read_text(outputs.at("points").path);
+  EXPECT_NE(points.find(",landmark,femoral_head_centre_r,"), std::string::npos);
+  EXPECT_NE(points.find(",path_point,vastus_r/vastus_r,"), std::string::npos);
+}
+
+TEST(FuseMotionNodeTest, NothingToDriveIsAnErrorWithAHint) {
+  test::NodeHarness harness;
+  try {
+    harness.run<FuseMotion>({{"trial", add_file(harness, pipelines() / "subject01_walk1.trc")}});
+    FAIL() << "ran without a model";
+  } catch (const InvalidInputError& error) {
+    EXPECT_NE(std::string(error.what()).find("connect 'atlas'"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace mmm::nodes
