@@ -105,7 +105,8 @@ TEST(WorkflowCliTest, NodesJsonIsMachineReadable) {
     EXPECT_EQ(type["manual"].get<bool>(), type["name"] == "landmark_station") << type["name"];
   }
   EXPECT_EQ(names,
-            (std::vector<std::string>{"decimate_mesh", "import_markups", "landmark_report",
+            (std::vector<std::string>{"decimate_mesh", "fuse_motion", "import_markups",
+                                      "landmark_report",
                                       "landmark_station", "load_mesh", "load_radiographs",
                                       "measure_mesh", "scale_atlas", "static_trial_landmarks"}))
       << "sorted by name";

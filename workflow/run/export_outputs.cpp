@@ -3,6 +3,8 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <iterator>
 #include <system_error>
@@ -75,11 +77,24 @@ std::string read_all(const std::filesystem::path& file) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// Extension of an opaque File from its first bytes, so that pictures and
-// documents open with a double click.
+// Whether the first line is a CSV header: names separated by at least one
+// comma, nothing that would make it markup or binary.
+bool csv_header(const std::string& head) {
+  const std::size_t end = head.find('\n');
+  if (end == std::string::npos || end == 0) return false;
+  const std::string line = head.substr(0, end);
+  if (std::count(line.begin(), line.end(), ',') < 1) return false;
+  return std::all_of(line.begin(), line.end(), [](char c) {
+    return c == ',' || c == '_' || c == '.' || c == ' ' || c == '"' || c == '\r' ||
+           std::isalnum(static_cast<unsigned char>(c)) != 0;
+  });
+}
+
+// Extension of an opaque File from its first bytes, so that pictures,
+// documents and the files of motion analysis open with a double click.
 std::string sniffed_extension(const std::filesystem::path& blob) {
   std::ifstream in(blob, std::ios::binary);
-  std::string head(64, '\0');
+  std::string head(4096, '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
   if (head.starts_with("\x89PNG\r\n\x1a\n")) return ".png";
@@ -89,6 +104,17 @@ std::string sniffed_extension(const std::filesystem::path& blob) {
   }
   if (head.starts_with("%PDF")) return ".pdf";
   if (head.starts_with("mmm-bundle 1\n")) return ".bundle";  // a folder (core/directory_bundle.h)
+  if (head.starts_with("PathFileType")) return ".trc";
+  // OpenSim storage: a header ending in "endheader" with a column count.
+  if (head.find("\nendheader") != std::string::npos &&
+      (head.find("nColumns=") != std::string::npos ||
+       head.find("datacolumns") != std::string::npos)) {
+    return ".mot";
+  }
+  if (head.starts_with("<?xml") && head.find("<OpenSimDocument") != std::string::npos) {
+    return ".osim";
+  }
+  if (csv_header(head)) return ".csv";
   return "";
 }
 

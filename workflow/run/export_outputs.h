@@ -27,9 +27,10 @@ ExportReport export_outputs(
     Study& study, const std::map<std::string, std::map<std::string, OutputArtifact>>& available);
 
 // The file name of an export: name + the extension of its port type; for an
-// opaque File, the extension its content shows (.png, .svg, .pdf, .bundle
-// for a folder bundle; none otherwise) when `blob` is given. An Atlas or a
-// folder bundle is also unpacked into the folder DIR/outputs/<name>/.
+// opaque File, the extension its content shows (.png, .svg, .pdf, .trc,
+// .mot, .osim, .csv, .bundle for a folder bundle; none otherwise) when
+// `blob` is given. An Atlas or a folder bundle is also unpacked into the
+// folder DIR/outputs/<name>/.
 std::string export_file_name(const std::string& name, PortType type,
                              const std::filesystem::path& blob = {});
 
