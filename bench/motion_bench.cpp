@@ -11,7 +11,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -30,11 +32,13 @@
 #include "core/motion/marker_placement.h"
 #include "core/motion/marker_mapping.h"
 #include "core/motion/motion_fusion.h"
+#include "core/motion/motion_plot.h"
 #include "core/motion/motion_tables.h"
 #include "core/motion/skeleton.h"
 #include "core/opensim/mot.h"
 #include "core/opensim/osim_model.h"
 #include "core/opensim/trc.h"
+#include "core/plot/svg_plot.h"
 #include "core/scaling/atlas_scaling.h"
 
 namespace {
@@ -83,7 +87,71 @@ const std::vector<std::pair<std::string, double>> kLimits = {
     {"hip_adduction_l", 3.0}, {"hip_rotation_l", 3.0},  {"knee_angle_l", 2.0},
     {"ankle_angle_l", 2.0}};
 
-void accuracy_table(std::ostream& out) {
+// The tracked markers' measured positions in one fused frame.
+Eigen::MatrixX3d targets_of(const motion::FusedMotion& fused, Eigen::Index k) {
+  const mmm::opensim::MarkerTrajectories& walk = subject().walk;
+  Eigen::MatrixX3d targets(static_cast<Eigen::Index>(fused.setup.markers.size()), 3);
+  for (std::size_t i = 0; i < fused.setup.markers.size(); ++i) {
+    targets.row(static_cast<Eigen::Index>(i)) =
+        walk.unit_to_mm *
+        walk.position(fused.trial_frames[static_cast<std::size_t>(k)], fused.setup.markers[i].trial)
+            .transpose();
+  }
+  return targets;
+}
+
+// Marker errors of OpenSim's own IK solution on the same model and markers
+// (its coordinates interpolated at our frame times): #frames by #markers.
+Eigen::MatrixXd opensim_marker_errors(const motion::FusedMotion& fused) {
+  const Subject& s = subject();
+  motion::ChainFitter evaluator(s.skeleton, fused.setup);
+  Eigen::MatrixXd errors(fused.num_frames(), static_cast<Eigen::Index>(fused.setup.markers.size()));
+  for (Eigen::Index k = 0; k < fused.num_frames(); ++k) {
+    const Eigen::RowVectorXd row = s.reference.interpolate(fused.times(k));
+    Eigen::VectorXd q = s.skeleton.default_coordinates();
+    for (int c = 0; c < s.skeleton.num_coordinates(); ++c) {
+      const motion::SkeletonCoordinate& coordinate = s.skeleton.coordinates[static_cast<std::size_t>(c)];
+      if (const auto column = s.reference.column_index(coordinate.name)) {
+        q(c) = coordinate.unit == motion::CoordinateUnit::kAngle ? row(*column) * 3.14159265358979 / 180.0
+                                                                 : row(*column) * 1000.0;
+      }
+    }
+    errors.row(k) = evaluator.evaluate(targets_of(fused, k), q).marker_errors.transpose();
+  }
+  return errors;
+}
+
+// RMS over the markers whose body is (not) the torso, and over all.
+struct MarkerRms {
+  double all = 0, lower_body = 0, upper_body = 0;
+  double weighted = 0;  // sqrt(sum w e^2 / sum w): the objective's own measure
+};
+MarkerRms marker_rms(const motion::FusedMotion& fused, const Eigen::MatrixXd& errors) {
+  const Subject& s = subject();
+  double sums[3] = {0, 0, 0};
+  double counts[3] = {0, 0, 0};
+  double weighted = 0;
+  double weights = 0;
+  for (Eigen::Index m = 0; m < errors.cols(); ++m) {
+    const int body = s.skeleton.markers[static_cast<std::size_t>(fused.setup.markers[static_cast<std::size_t>(m)].model)].body;
+    const bool torso = s.skeleton.bodies[static_cast<std::size_t>(body)].name == "torso";
+    for (Eigen::Index k = 0; k < errors.rows(); ++k) {
+      const double e = errors(k, m);
+      if (!std::isfinite(e)) continue;
+      const double w = fused.setup.markers[static_cast<std::size_t>(m)].weight;
+      weighted += w * e * e;
+      weights += w;
+      for (const int g : {0, torso ? 2 : 1}) {
+        sums[g] += e * e;
+        counts[g] += 1;
+      }
+    }
+  }
+  const auto rms = [&](int g) { return counts[g] > 0 ? std::sqrt(sums[g] / counts[g]) : 0.0; };
+  return {rms(0), rms(1), rms(2), weights > 0 ? std::sqrt(weighted / weights) : 0.0};
+}
+
+nlohmann::json accuracy_table(std::ostream& out) {
   const Subject& s = subject();
   const motion::MarkerMapping mapping = motion::gait2392_marker_mapping();
   const std::vector<std::pair<std::string, motion::FilterMode>> modes = {
@@ -91,51 +159,92 @@ void accuracy_table(std::ostream& out) {
       {"forward", motion::FilterMode::kForward},
       {"smoother", motion::FilterMode::kSmoother}};
   std::map<std::string, std::map<std::string, motion::CoordinateDifference>> by_mode;
-  std::map<std::string, double> marker_rms;
+  std::map<std::string, MarkerRms> rms;
+  std::optional<motion::FusedMotion> smoothed;
+  MarkerRms theirs;
   for (const auto& [name, mode] : modes) {
-    const motion::FusedMotion fused =
-        motion::fuse_motion(s.skeleton, s.walk, mapping, walk_options(mode));
+    motion::FusedMotion fused = motion::fuse_motion(s.skeleton, s.walk, mapping, walk_options(mode));
     for (const motion::CoordinateDifference& d : motion::compare_coordinates(fused, s.reference)) {
       by_mode[name][d.coordinate] = d;
     }
-    marker_rms[name] = fused.overall_rms_mm();
-    if (mode == motion::FilterMode::kNone) {
-      out << "per-marker RMS (mm):";
-      for (Eigen::Index m = 0; m < fused.marker_errors.cols(); ++m) {
-        double squares = 0;
-        int count = 0;
-        for (Eigen::Index f = 0; f < fused.marker_errors.rows(); ++f) {
-          if (std::isfinite(fused.marker_errors(f, m))) {
-            squares += fused.marker_errors(f, m) * fused.marker_errors(f, m);
-            ++count;
-          }
-        }
-        out << " " << fused.marker_names[static_cast<std::size_t>(m)] << " "
-            << fixed(std::sqrt(squares / std::max(1, count)), 1);
-      }
-      out << "\n";
-    }
-    for (const std::string& note : fused.notes) out << "note (" << name << "): " << note << "\n";
+    rms[name] = marker_rms(fused, fused.marker_errors);
+    if (mode == motion::FilterMode::kNone) theirs = marker_rms(fused, opensim_marker_errors(fused));
+    if (mode == motion::FilterMode::kSmoother) smoothed = std::move(fused);
   }
-  out << "\nours vs OpenSim IK, subject01_walk1 0.5-2.5 s, OpenSim's scaled model; RMS "
-         "difference (deg, pelvis translations mm) per filter\n";
+  out << "\nours vs OpenSim IK: subject01_walk1, 0.5-2.5 s (" << smoothed->num_frames()
+      << " frames), OpenSim's scaled model, gait2392 IK weights;\nRMS difference per "
+         "coordinate (deg; pelvis translations mm), per filter of ours\n";
   out << std::left << std::setw(20) << "coordinate";
   for (const auto& [name, mode] : modes) out << " " << std::setw(10) << name;
   out << " limit\n";
+  nlohmann::json coordinates = nlohmann::json::array();
   for (const auto& [coordinate, difference] : by_mode["none"]) {
-    out << std::setw(20) << coordinate;
-    for (const auto& [name, mode] : modes) {
-      out << " " << std::setw(10) << fixed(by_mode[name][coordinate].rms, 2);
-    }
     std::string limit;
     for (const auto& [c, l] : kLimits) {
       if (c == coordinate) limit = "<= " + fixed(l, 0);
     }
+    out << std::setw(20) << coordinate;
+    nlohmann::json row = {{"coordinate", coordinate}, {"limit", limit},
+                          {"unit", difference.angle ? "deg" : "mm"},
+                          {"opensim_range", difference.reference_range}};
+    for (const auto& [name, mode] : modes) {
+      out << " " << std::setw(10) << fixed(by_mode[name][coordinate].rms, 3);
+      row["rms_" + name] = by_mode[name][coordinate].rms;
+      row["max_" + name] = by_mode[name][coordinate].max_abs;
+    }
     out << " " << limit << "\n";
+    coordinates.push_back(row);
   }
-  out << std::setw(20) << "marker RMS (mm)";
-  for (const auto& [name, mode] : modes) out << " " << std::setw(10) << fixed(marker_rms[name], 2);
-  out << " <= 10\n";
+  nlohmann::json markers = nlohmann::json::object();
+  const auto marker_row = [&](const char* label, double MarkerRms::*field) {
+    out << std::setw(20) << label;
+    for (const auto& [name, mode] : modes) {
+      out << " " << std::setw(10) << fixed(rms[name].*field, 2);
+      markers[label][name] = rms[name].*field;
+    }
+    out << " OpenSim's own solution " << fixed(theirs.*field, 2) << "\n";
+    markers[label]["opensim"] = theirs.*field;
+  };
+  out << "marker RMS (mm), same model and markers:\n";
+  marker_row("  pelvis + legs", &MarkerRms::lower_body);
+  marker_row("  torso (4 markers)", &MarkerRms::upper_body);
+  marker_row("  all 31 tracked", &MarkerRms::all);
+  marker_row("  all, IK-weighted", &MarkerRms::weighted);
+  // OpenSim's model with its markers re-placed by us on the static trial:
+  // what the residual owes to marker placement.
+  const motion::MarkerPlacement placed = motion::place_markers(
+      s.skeleton, mmm::opensim::read_trc(pipelines() / "subject01_static.trc"), mapping);
+  const motion::FusedMotion replaced = motion::fuse_motion(
+      placed.skeleton, s.walk, mapping, walk_options(motion::FilterMode::kSmoother));
+  const MarkerRms replaced_rms = marker_rms(replaced, replaced.marker_errors);
+  double worst_leg = 0.0;
+  std::string worst_name;
+  for (const motion::CoordinateDifference& d : motion::compare_coordinates(replaced, s.reference)) {
+    for (const auto& [c, l] : kLimits) {
+      if (c == d.coordinate && d.rms > worst_leg) {
+        worst_leg = d.rms;
+        worst_name = c;
+      }
+    }
+  }
+  out << "OpenSim's model, markers re-placed on subject01_static.trc (smoother): marker RMS "
+      << fixed(replaced_rms.lower_body, 2) << " mm pelvis + legs, " << fixed(replaced_rms.all, 2)
+      << " mm all; worst leg angle vs OpenSim " << fixed(worst_leg, 2) << " deg (" << worst_name
+      << ")\n";
+  markers["markers re-placed"] = {{"pelvis + legs", replaced_rms.lower_body},
+                                  {"all", replaced_rms.all},
+                                  {"worst_leg_angle_rms_deg", worst_leg},
+                                  {"worst_leg_angle", worst_name}};
+  // The plot: both legs' angles, ours (smoother) over OpenSim's.
+  motion::AnglePlotOptions plot;
+  plot.title = "subject01_walk1: mmm (smoother) vs OpenSim IK, OpenSim's scaled model";
+  const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
+  const std::filesystem::path folder = out_dir != nullptr ? out_dir : ".";
+  mmm::plot::write_svg(motion::joint_angle_svg(*smoothed, &s.reference, plot),
+                       folder / "motion_angles.svg");
+  out << "plot: " << (folder / "motion_angles.svg").string() << "\n";
+  return {{"coordinates", coordinates}, {"marker_rms_mm", markers},
+          {"frames", smoothed->num_frames()}};
 }
 
 // RMS of the second difference of a coordinate over the frames (deg/s^2):
@@ -155,7 +264,8 @@ double roughness(const motion::FusedMotion& fused, const std::string& coordinate
   return std::sqrt(squares / static_cast<double>(std::max<Eigen::Index>(1, count)));
 }
 
-void filter_sweep(std::ostream& out) {
+nlohmann::json filter_sweep(std::ostream& out) {
+  nlohmann::json rows = nlohmann::json::array();
   const Subject& s = subject();
   const motion::MarkerMapping mapping = motion::gait2392_marker_mapping();
   out << "\nfilter sweep (smoother): sigma_a rad/s^2 -> worst RMS vs OpenSim over the leg "
@@ -173,10 +283,53 @@ void filter_sweep(std::ostream& out) {
     out << "  " << std::setw(8) << sigma << " " << std::setw(8) << fixed(worst, 2) << " "
         << std::setw(10) << fixed(roughness(fused, "knee_angle_r"), 0) << " "
         << fixed(fused.overall_rms_mm(), 2) << "\n";
+    rows.push_back({{"sigma_a", sigma}, {"worst_leg_rms_deg", worst},
+                    {"knee_roughness_deg_s2", roughness(fused, "knee_angle_r")}});
   }
   const motion::FusedMotion raw = motion::fuse_motion(s.skeleton, s.walk, mapping,
                                                       walk_options(motion::FilterMode::kNone));
   out << "  none     0.00 " << std::setw(10) << fixed(roughness(raw, "knee_angle_r"), 0) << "\n";
+  return rows;
+}
+
+// A gap: the right shank and foot clusters vanish for 0.2 s mid-swing.
+// Knee and ankle against the full-data answer, per filter.
+nlohmann::json gap_table(std::ostream& out) {
+  const Subject& s = subject();
+  const motion::MarkerMapping mapping = motion::gait2392_marker_mapping();
+  mmm::opensim::MarkerTrajectories gappy = s.walk;
+  const Eigen::Index first = *gappy.frame_at_time(1.3);
+  const Eigen::Index last = *gappy.frame_at_time(1.5);
+  for (const char* name : {"R.Shank.Upper", "R.Shank.Front", "R.Shank.Rear", "R.Midfoot.Sup",
+                           "R.Midfoot.Lat", "R.Toe.Lat", "R.Toe.Med"}) {
+    const Eigen::Index column = 3 * *gappy.marker_index(name);
+    gappy.positions.block(first, column, last - first + 1, 3).setConstant(std::nan(""));
+  }
+  const motion::FusedMotion full =
+      motion::fuse_motion(s.skeleton, s.walk, mapping, walk_options(motion::FilterMode::kNone));
+  out << "\ngap 1.3-1.5 s (right shank and midfoot/toe markers missing): worst error in the gap "
+         "vs the full-data answer (deg)\n";
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& [name, mode] : std::vector<std::pair<std::string, motion::FilterMode>>{
+           {"none", motion::FilterMode::kNone}, {"smoother", motion::FilterMode::kSmoother}}) {
+    const motion::FusedMotion fused = motion::fuse_motion(s.skeleton, gappy, mapping, walk_options(mode));
+    out << "  " << std::setw(10) << name;
+    nlohmann::json row = {{"filter", name}};
+    for (const char* coordinate : {"knee_angle_r", "ankle_angle_r", "hip_rotation_r"}) {
+      const int c = *fused.coordinate_index(coordinate);
+      double worst = 0;
+      for (Eigen::Index k = 0; k < fused.num_frames(); ++k) {
+        if (fused.times(k) < 1.3 - 1e-6 || fused.times(k) > 1.5 + 1e-6) continue;
+        worst = std::max(worst, std::abs(fused.coordinates(k, c) - full.coordinates(k, c)) * 180.0 /
+                                    3.14159265358979);
+      }
+      out << " " << coordinate << " " << fixed(worst, 2);
+      row[coordinate] = worst;
+    }
+    out << "\n";
+    rows.push_back(row);
+  }
+  return rows;
 }
 
 // Our own pipeline for the subject: joint centres and ASIS from the static
@@ -242,7 +395,8 @@ const OwnScaling& own_scaling() {
   return data;
 }
 
-void own_scaling_table(std::ostream& out) {
+nlohmann::json own_scaling_table(std::ostream& out) {
+  nlohmann::json rows = nlohmann::json::array();
   const Subject& s = subject();
   const OwnScaling& own = own_scaling();
   const motion::MarkerMapping mapping = motion::gait2392_marker_mapping();
@@ -259,39 +413,82 @@ void own_scaling_table(std::ostream& out) {
       << "  static pose marker RMS " << fixed(own.placed.rms_before_mm, 1) << " mm before placing, "
       << fixed(own.placed.rms_after_mm, 1) << " mm after\n";
   out << std::left << std::setw(20) << "coordinate" << " " << std::setw(22) << "atlas markers"
-      << " " << std::setw(22) << "markers placed" << "\n";
+      << " " << std::setw(22) << "markers placed" << " placed, offset removed\n";
   for (const auto& [coordinate, d] : b) {
+    const double centred = std::sqrt(std::max(0.0, d.rms * d.rms - d.mean * d.mean));
     out << std::setw(20) << coordinate << " " << std::setw(22)
         << fixed(a[coordinate].rms, 2) + " (" + fixed(a[coordinate].mean, 2) + ")" << " "
-        << std::setw(22) << fixed(d.rms, 2) + " (" + fixed(d.mean, 2) + ")" << "\n";
+        << std::setw(22) << fixed(d.rms, 2) + " (" + fixed(d.mean, 2) + ")" << " "
+        << fixed(centred, 2) << "\n";
+    rows.push_back({{"coordinate", coordinate}, {"rms_atlas_markers", a[coordinate].rms},
+                    {"mean_atlas_markers", a[coordinate].mean}, {"rms_placed", d.rms},
+                    {"mean_placed", d.mean}, {"rms_placed_without_offset", centred}});
   }
   out << std::setw(20) << "marker RMS (mm)" << " " << std::setw(22)
       << fixed(generic_markers.overall_rms_mm(), 2) << " " << std::setw(22)
       << fixed(placed.overall_rms_mm(), 2) << "\n";
+  motion::AnglePlotOptions plot;
+  plot.title = "subject01_walk1: mmm on the default atlas scaled to subject01 vs OpenSim IK";
+  const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
+  mmm::plot::write_svg(motion::joint_angle_svg(placed, &s.reference, plot),
+                       std::filesystem::path(out_dir != nullptr ? out_dir : ".") /
+                           "motion_angles_own_scaling.svg");
+  return {{"coordinates", rows},
+          {"marker_rms_mm", {{"atlas_markers", generic_markers.overall_rms_mm()},
+                             {"placed", placed.overall_rms_mm()}}},
+          {"static_pose_rms_mm", {{"before", own.placed.rms_before_mm},
+                                  {"after", own.placed.rms_after_mm}}}};
 }
 
+// The tables on stdout and beside the JSON (motion.accuracy.txt), which
+// bench/table.py prints above the speed table.
 void write_accuracy_table() {
   std::ostringstream text;
-  accuracy_table(text);
-  filter_sweep(text);
-  own_scaling_table(text);
+  nlohmann::json document;
+  document["opensim_model"] = accuracy_table(text);
+  document["filter_sweep"] = filter_sweep(text);
+  document["gap"] = gap_table(text);
+  document["own_scaling"] = own_scaling_table(text);
   std::cout << text.str();
+  const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
+  const std::filesystem::path folder = out_dir != nullptr ? out_dir : ".";
+  std::ofstream(folder / "motion.accuracy.json") << document.dump(2) << "\n";
+  std::ofstream(folder / "motion.accuracy.txt") << text.str();
 }
 
+// The kinematic fit alone: one Ceres solve per frame, warm-started from the
+// previous frame, over the 121 frames (items = frames).
 void BM_ChainFitPerFrame(benchmark::State& state) {
   const Subject& s = subject();
   const motion::FusedMotion fused = motion::fuse_motion(
-      s.skeleton, s.walk, motion::gait2392_marker_mapping(),
-      walk_options(motion::FilterMode::kNone));
+      s.skeleton, s.walk, motion::gait2392_marker_mapping(), walk_options(motion::FilterMode::kNone));
+  std::vector<Eigen::MatrixX3d> targets;
+  for (Eigen::Index k = 0; k < fused.num_frames(); ++k) targets.push_back(targets_of(fused, k));
+  motion::ChainFitter fitter(s.skeleton, fused.setup);
   for (auto _ : state) {
-    const motion::FusedMotion again = motion::fuse_motion(
-        s.skeleton, s.walk, motion::gait2392_marker_mapping(),
-        walk_options(motion::FilterMode::kNone));
-    benchmark::DoNotOptimize(again.coordinates.data());
+    Eigen::VectorXd q = fused.coordinates.row(0).transpose();
+    for (const Eigen::MatrixX3d& frame : targets) q = fitter.fit(frame, q).q;
+    benchmark::DoNotOptimize(q.data());
   }
   state.SetItemsProcessed(state.iterations() * fused.num_frames());
 }
 BENCHMARK(BM_ChainFitPerFrame)->Unit(benchmark::kMillisecond);
+
+// The whole fusion of the trial (free-body registrations, start, fit,
+// Kalman filter, smoother, poses, errors), items = frames.
+void BM_FuseTrialSmoother(benchmark::State& state) {
+  const Subject& s = subject();
+  const motion::MarkerMapping mapping = motion::gait2392_marker_mapping();
+  Eigen::Index frames = 0;
+  for (auto _ : state) {
+    const motion::FusedMotion fused =
+        motion::fuse_motion(s.skeleton, s.walk, mapping, walk_options(motion::FilterMode::kSmoother));
+    frames = fused.num_frames();
+    benchmark::DoNotOptimize(fused.coordinates.data());
+  }
+  state.SetItemsProcessed(state.iterations() * frames);
+}
+BENCHMARK(BM_FuseTrialSmoother)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
