@@ -11,15 +11,16 @@
 
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
-#include <optional>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -29,8 +30,8 @@
 #include "core/fit/rigid_fit.h"
 #include "core/landmarks/static_trial_landmarks.h"
 #include "core/motion/chain_fit.h"
-#include "core/motion/marker_placement.h"
 #include "core/motion/marker_mapping.h"
+#include "core/motion/marker_placement.h"
 #include "core/motion/motion_fusion.h"
 #include "core/motion/motion_plot.h"
 #include "core/motion/motion_tables.h"
@@ -110,10 +111,12 @@ Eigen::MatrixXd opensim_marker_errors(const motion::FusedMotion& fused) {
     const Eigen::RowVectorXd row = s.reference.interpolate(fused.times(k));
     Eigen::VectorXd q = s.skeleton.default_coordinates();
     for (int c = 0; c < s.skeleton.num_coordinates(); ++c) {
-      const motion::SkeletonCoordinate& coordinate = s.skeleton.coordinates[static_cast<std::size_t>(c)];
+      const motion::SkeletonCoordinate& coordinate =
+          s.skeleton.coordinates[static_cast<std::size_t>(c)];
       if (const auto column = s.reference.column_index(coordinate.name)) {
-        q(c) = coordinate.unit == motion::CoordinateUnit::kAngle ? row(*column) * 3.14159265358979 / 180.0
-                                                                 : row(*column) * 1000.0;
+        q(c) = coordinate.unit == motion::CoordinateUnit::kAngle
+                   ? row(*column) * 3.14159265358979 / 180.0
+                   : row(*column) * 1000.0;
       }
     }
     errors.row(k) = evaluator.evaluate(targets_of(fused, k), q).marker_errors.transpose();
@@ -128,12 +131,15 @@ struct MarkerRms {
 };
 MarkerRms marker_rms(const motion::FusedMotion& fused, const Eigen::MatrixXd& errors) {
   const Subject& s = subject();
-  double sums[3] = {0, 0, 0};
-  double counts[3] = {0, 0, 0};
+  std::array<double, 3> sums = {0, 0, 0};
+  std::array<double, 3> counts = {0, 0, 0};
   double weighted = 0;
   double weights = 0;
   for (Eigen::Index m = 0; m < errors.cols(); ++m) {
-    const int body = s.skeleton.markers[static_cast<std::size_t>(fused.setup.markers[static_cast<std::size_t>(m)].model)].body;
+    const int body = s.skeleton
+                         .markers[static_cast<std::size_t>(
+                             fused.setup.markers[static_cast<std::size_t>(m)].model)]
+                         .body;
     const bool torso = s.skeleton.bodies[static_cast<std::size_t>(body)].name == "torso";
     for (Eigen::Index k = 0; k < errors.rows(); ++k) {
       const double e = errors(k, m);
@@ -141,13 +147,15 @@ MarkerRms marker_rms(const motion::FusedMotion& fused, const Eigen::MatrixXd& er
       const double w = fused.setup.markers[static_cast<std::size_t>(m)].weight;
       weighted += w * e * e;
       weights += w;
-      for (const int g : {0, torso ? 2 : 1}) {
-        sums[g] += e * e;
-        counts[g] += 1;
+      for (const std::size_t g : {std::size_t{0}, std::size_t{torso ? 2U : 1U}}) {
+        sums.at(g) += e * e;
+        counts.at(g) += 1;
       }
     }
   }
-  const auto rms = [&](int g) { return counts[g] > 0 ? std::sqrt(sums[g] / counts[g]) : 0.0; };
+  const auto rms = [&](std::size_t g) {
+    return counts.at(g) > 0 ? std::sqrt(sums.at(g) / counts.at(g)) : 0.0;
+  };
   return {rms(0), rms(1), rms(2), weights > 0 ? std::sqrt(weighted / weights) : 0.0};
 }
 
@@ -163,7 +171,8 @@ nlohmann::json accuracy_table(std::ostream& out) {
   std::optional<motion::FusedMotion> smoothed;
   MarkerRms theirs;
   for (const auto& [name, mode] : modes) {
-    motion::FusedMotion fused = motion::fuse_motion(s.skeleton, s.walk, mapping, walk_options(mode));
+    motion::FusedMotion fused =
+        motion::fuse_motion(s.skeleton, s.walk, mapping, walk_options(mode));
     for (const motion::CoordinateDifference& d : motion::compare_coordinates(fused, s.reference)) {
       by_mode[name][d.coordinate] = d;
     }
@@ -184,7 +193,8 @@ nlohmann::json accuracy_table(std::ostream& out) {
       if (c == coordinate) limit = "<= " + fixed(l, 0);
     }
     out << std::setw(20) << coordinate;
-    nlohmann::json row = {{"coordinate", coordinate}, {"limit", limit},
+    nlohmann::json row = {{"coordinate", coordinate},
+                          {"limit", limit},
                           {"unit", difference.angle ? "deg" : "mm"},
                           {"opensim_range", difference.reference_range}};
     for (const auto& [name, mode] : modes) {
@@ -243,8 +253,8 @@ nlohmann::json accuracy_table(std::ostream& out) {
   mmm::plot::write_svg(motion::joint_angle_svg(*smoothed, &s.reference, plot),
                        folder / "motion_angles.svg");
   out << "plot: " << (folder / "motion_angles.svg").string() << "\n";
-  return {{"coordinates", coordinates}, {"marker_rms_mm", markers},
-          {"frames", smoothed->num_frames()}};
+  return {
+      {"coordinates", coordinates}, {"marker_rms_mm", markers}, {"frames", smoothed->num_frames()}};
 }
 
 // RMS of the second difference of a coordinate over the frames (deg/s^2):
@@ -255,9 +265,9 @@ double roughness(const motion::FusedMotion& fused, const std::string& coordinate
   Eigen::Index count = 0;
   for (Eigen::Index k = 1; k + 1 < fused.num_frames(); ++k) {
     const double dt = fused.times(k + 1) - fused.times(k);
-    const double a = (fused.coordinates(k + 1, c) - 2 * fused.coordinates(k, c) +
-                      fused.coordinates(k - 1, c)) /
-                     (dt * dt) * 180.0 / 3.14159265358979;
+    const double a =
+        (fused.coordinates(k + 1, c) - 2 * fused.coordinates(k, c) + fused.coordinates(k - 1, c)) /
+        (dt * dt) * 180.0 / 3.14159265358979;
     squares += a * a;
     ++count;
   }
@@ -283,11 +293,12 @@ nlohmann::json filter_sweep(std::ostream& out) {
     out << "  " << std::setw(8) << sigma << " " << std::setw(8) << fixed(worst, 2) << " "
         << std::setw(10) << fixed(roughness(fused, "knee_angle_r"), 0) << " "
         << fixed(fused.overall_rms_mm(), 2) << "\n";
-    rows.push_back({{"sigma_a", sigma}, {"worst_leg_rms_deg", worst},
+    rows.push_back({{"sigma_a", sigma},
+                    {"worst_leg_rms_deg", worst},
                     {"knee_roughness_deg_s2", roughness(fused, "knee_angle_r")}});
   }
-  const motion::FusedMotion raw = motion::fuse_motion(s.skeleton, s.walk, mapping,
-                                                      walk_options(motion::FilterMode::kNone));
+  const motion::FusedMotion raw =
+      motion::fuse_motion(s.skeleton, s.walk, mapping, walk_options(motion::FilterMode::kNone));
   out << "  none     0.00 " << std::setw(10) << fixed(roughness(raw, "knee_angle_r"), 0) << "\n";
   return rows;
 }
@@ -312,7 +323,8 @@ nlohmann::json gap_table(std::ostream& out) {
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [name, mode] : std::vector<std::pair<std::string, motion::FilterMode>>{
            {"none", motion::FilterMode::kNone}, {"smoother", motion::FilterMode::kSmoother}}) {
-    const motion::FusedMotion fused = motion::fuse_motion(s.skeleton, gappy, mapping, walk_options(mode));
+    const motion::FusedMotion fused =
+        motion::fuse_motion(s.skeleton, gappy, mapping, walk_options(mode));
     out << "  " << std::setw(10) << name;
     nlohmann::json row = {{"filter", name}};
     for (const char* coordinate : {"knee_angle_r", "ankle_angle_r", "hip_rotation_r"}) {
@@ -346,10 +358,10 @@ mmm::landmarks::LandmarkSet static_trial_station(const mmm::atlas::Atlas& atlas,
   const auto rest = [&](const char* name) { return atlas.find_landmark(name)->position; };
   Eigen::MatrixX3d from(3, 3);
   Eigen::MatrixX3d to(3, 3);
-  const char* pelvis[] = {"asis_r", "asis_l", "femoral_head_centre_r"};
+  const std::array<const char*, 3> pelvis = {"asis_r", "asis_l", "femoral_head_centre_r"};
   for (int i = 0; i < 3; ++i) {
-    from.row(i) = rest(pelvis[i]).transpose();
-    to.row(i) = lab(pelvis[i]).transpose();
+    from.row(i) = rest(pelvis.at(static_cast<std::size_t>(i))).transpose();
+    to.row(i) = lab(pelvis.at(static_cast<std::size_t>(i))).transpose();
   }
   const Eigen::Matrix3d turn = mmm::fit::rigid_fit(from, to).rigid.linear();
   const Eigen::Vector3d femur_rest = turn * (rest("knee_centre_r") - rest("femoral_head_centre_r"));
@@ -400,44 +412,51 @@ nlohmann::json own_scaling_table(std::ostream& out) {
   const Subject& s = subject();
   const OwnScaling& own = own_scaling();
   const motion::MarkerMapping mapping = motion::gait2392_marker_mapping();
-  const motion::FusedMotion generic_markers = motion::fuse_motion(
-      own.scaled, s.walk, mapping, walk_options(motion::FilterMode::kSmoother));
+  const motion::FusedMotion generic_markers =
+      motion::fuse_motion(own.scaled, s.walk, mapping, walk_options(motion::FilterMode::kSmoother));
   const motion::FusedMotion placed = motion::fuse_motion(
       own.placed.skeleton, s.walk, mapping, walk_options(motion::FilterMode::kSmoother));
   std::map<std::string, motion::CoordinateDifference> a;
   std::map<std::string, motion::CoordinateDifference> b;
-  for (const auto& d : motion::compare_coordinates(generic_markers, s.reference)) a[d.coordinate] = d;
+  for (const auto& d : motion::compare_coordinates(generic_markers, s.reference))
+    a[d.coordinate] = d;
   for (const auto& d : motion::compare_coordinates(placed, s.reference)) b[d.coordinate] = d;
   out << "\nours with our own scaling (static-trial landmarks -> default atlas scaled) vs "
          "OpenSim IK; RMS (mean offset) in deg / mm\n"
       << "  static pose marker RMS " << fixed(own.placed.rms_before_mm, 1) << " mm before placing, "
       << fixed(own.placed.rms_after_mm, 1) << " mm after\n";
-  out << std::left << std::setw(20) << "coordinate" << " " << std::setw(22) << "atlas markers"
-      << " " << std::setw(22) << "markers placed" << " placed, offset removed\n";
+  out << std::left << std::setw(20) << "coordinate"
+      << " " << std::setw(22) << "atlas markers"
+      << " " << std::setw(22) << "markers placed"
+      << " placed, offset removed\n";
   for (const auto& [coordinate, d] : b) {
     const double centred = std::sqrt(std::max(0.0, d.rms * d.rms - d.mean * d.mean));
     out << std::setw(20) << coordinate << " " << std::setw(22)
-        << fixed(a[coordinate].rms, 2) + " (" + fixed(a[coordinate].mean, 2) + ")" << " "
-        << std::setw(22) << fixed(d.rms, 2) + " (" + fixed(d.mean, 2) + ")" << " "
-        << fixed(centred, 2) << "\n";
-    rows.push_back({{"coordinate", coordinate}, {"rms_atlas_markers", a[coordinate].rms},
-                    {"mean_atlas_markers", a[coordinate].mean}, {"rms_placed", d.rms},
-                    {"mean_placed", d.mean}, {"rms_placed_without_offset", centred}});
+        << fixed(a[coordinate].rms, 2) + " (" + fixed(a[coordinate].mean, 2) + ")"
+        << " " << std::setw(22) << fixed(d.rms, 2) + " (" + fixed(d.mean, 2) + ")"
+        << " " << fixed(centred, 2) << "\n";
+    rows.push_back({{"coordinate", coordinate},
+                    {"rms_atlas_markers", a[coordinate].rms},
+                    {"mean_atlas_markers", a[coordinate].mean},
+                    {"rms_placed", d.rms},
+                    {"mean_placed", d.mean},
+                    {"rms_placed_without_offset", centred}});
   }
-  out << std::setw(20) << "marker RMS (mm)" << " " << std::setw(22)
-      << fixed(generic_markers.overall_rms_mm(), 2) << " " << std::setw(22)
+  out << std::setw(20) << "marker RMS (mm)"
+      << " " << std::setw(22) << fixed(generic_markers.overall_rms_mm(), 2) << " " << std::setw(22)
       << fixed(placed.overall_rms_mm(), 2) << "\n";
   motion::AnglePlotOptions plot;
   plot.title = "subject01_walk1: mmm on the default atlas scaled to subject01 vs OpenSim IK";
   const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
-  mmm::plot::write_svg(motion::joint_angle_svg(placed, &s.reference, plot),
-                       std::filesystem::path(out_dir != nullptr ? out_dir : ".") /
-                           "motion_angles_own_scaling.svg");
-  return {{"coordinates", rows},
-          {"marker_rms_mm", {{"atlas_markers", generic_markers.overall_rms_mm()},
-                             {"placed", placed.overall_rms_mm()}}},
-          {"static_pose_rms_mm", {{"before", own.placed.rms_before_mm},
-                                  {"after", own.placed.rms_after_mm}}}};
+  mmm::plot::write_svg(
+      motion::joint_angle_svg(placed, &s.reference, plot),
+      std::filesystem::path(out_dir != nullptr ? out_dir : ".") / "motion_angles_own_scaling.svg");
+  return {
+      {"coordinates", rows},
+      {"marker_rms_mm",
+       {{"atlas_markers", generic_markers.overall_rms_mm()}, {"placed", placed.overall_rms_mm()}}},
+      {"static_pose_rms_mm",
+       {{"before", own.placed.rms_before_mm}, {"after", own.placed.rms_after_mm}}}};
 }
 
 // The tables on stdout and beside the JSON (motion.accuracy.txt), which
@@ -460,8 +479,9 @@ void write_accuracy_table() {
 // previous frame, over the 121 frames (items = frames).
 void BM_ChainFitPerFrame(benchmark::State& state) {
   const Subject& s = subject();
-  const motion::FusedMotion fused = motion::fuse_motion(
-      s.skeleton, s.walk, motion::gait2392_marker_mapping(), walk_options(motion::FilterMode::kNone));
+  const motion::FusedMotion fused =
+      motion::fuse_motion(s.skeleton, s.walk, motion::gait2392_marker_mapping(),
+                          walk_options(motion::FilterMode::kNone));
   std::vector<Eigen::MatrixX3d> targets;
   for (Eigen::Index k = 0; k < fused.num_frames(); ++k) targets.push_back(targets_of(fused, k));
   motion::ChainFitter fitter(s.skeleton, fused.setup);
@@ -481,8 +501,8 @@ void BM_FuseTrialSmoother(benchmark::State& state) {
   const motion::MarkerMapping mapping = motion::gait2392_marker_mapping();
   Eigen::Index frames = 0;
   for (auto _ : state) {
-    const motion::FusedMotion fused =
-        motion::fuse_motion(s.skeleton, s.walk, mapping, walk_options(motion::FilterMode::kSmoother));
+    const motion::FusedMotion fused = motion::fuse_motion(
+        s.skeleton, s.walk, mapping, walk_options(motion::FilterMode::kSmoother));
     frames = fused.num_frames();
     benchmark::DoNotOptimize(fused.coordinates.data());
   }

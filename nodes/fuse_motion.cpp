@@ -82,11 +82,12 @@ nlohmann::json fit_summary(const motion::FusedMotion& fused) {
   }
   nlohmann::json bodies = nlohmann::json::array();
   for (const motion::BodyRegistrationSummary& r : fused.registrations) {
-    bodies.push_back({{"body", r.body},
-                      {"frames_registered", r.frames_registered},
-                      {"cluster_rms_mm", r.cluster_rms_mm},
-                      {"joint_gap_mm", std::isfinite(r.joint_gap_mm) ? nlohmann::json(r.joint_gap_mm)
-                                                                     : nlohmann::json(nullptr)}});
+    bodies.push_back(
+        {{"body", r.body},
+         {"frames_registered", r.frames_registered},
+         {"cluster_rms_mm", r.cluster_rms_mm},
+         {"joint_gap_mm", std::isfinite(r.joint_gap_mm) ? nlohmann::json(r.joint_gap_mm)
+                                                        : nlohmann::json(nullptr)}});
   }
   std::vector<double> per_frame(fused.rms_mm.data(), fused.rms_mm.data() + fused.rms_mm.size());
   std::vector<double> seconds(fused.fit_seconds.data(),
@@ -118,7 +119,8 @@ std::string animation_bundle(const workflow::NodeContext& context, const motion:
       for (const atlas::MeshLevel& m : bone.meshes) {
         if (m.level == level) chosen = &m;
       }
-      bones.emplace_back(*skeleton.body_index(bone.name), mesh::read_mesh(atlas_dir / chosen->file));
+      bones.emplace_back(*skeleton.body_index(bone.name),
+                         mesh::read_mesh(atlas_dir / chosen->file));
     }
   }
   std::optional<motion::PointTrajectories> points;
@@ -161,7 +163,8 @@ std::string animation_bundle(const workflow::NodeContext& context, const motion:
         }
         if (points->active(k, static_cast<Eigen::Index>(i)) == 0) continue;
         line.push_back(static_cast<int>(xyz.size()));
-        xyz.emplace_back(points->positions.block<1, 3>(k, 3 * static_cast<Eigen::Index>(i)).transpose());
+        xyz.emplace_back(
+            points->positions.block<1, 3>(k, 3 * static_cast<Eigen::Index>(i)).transpose());
       }
       flush();
       if (!lines.lines.empty()) {
@@ -215,8 +218,8 @@ workflow::NodeSpec FuseMotion::spec() {
                      "Filter process noise of translations (mm/s^2 per sqrt(Hz))",
                      {.min = 1e-3, .max = 1e8})
       .param<double>("marker_noise_mm", d.filter.marker_noise_mm,
-                     "Noise of a weight-1 marker, as the filter assumes it", {.min = 0.01, .max = 100},
-                     "mm")
+                     "Noise of a weight-1 marker, as the filter assumes it",
+                     {.min = 0.01, .max = 100}, "mm")
       .param<bool>("joint_limits", true, "Keep clamped coordinates inside their ranges")
       .param<bool>("keep_ground_contact", true,
                    "Retargeting: shift the patient vertically so that its feet reach the ground "
@@ -240,9 +243,9 @@ void FuseMotion::run(workflow::NodeContext& context) {
       opensim::parse_trc(context.input_bytes("trial"), context.input("trial").path);
   for (const std::string& warning : trial.warnings) context.warn("trial: " + warning);
   const motion::MarkerMapping mapping =
-      context.has_input("mapping")
-          ? motion::parse_marker_mapping(context.input_bytes("mapping"), context.input("mapping").path)
-          : motion::gait2392_marker_mapping();
+      context.has_input("mapping") ? motion::parse_marker_mapping(context.input_bytes("mapping"),
+                                                                  context.input("mapping").path)
+                                   : motion::gait2392_marker_mapping();
   if (!context.has_input("atlas") && !context.has_input("model")) {
     throw InvalidInputError(
         "fuse_motion: nothing to drive; connect 'atlas' (a patient's atlas) or 'model' (an "
@@ -262,8 +265,7 @@ void FuseMotion::run(workflow::NodeContext& context) {
     subject = motion::skeleton_from_osim(model);
     subject_name = model.name;
   }
-  const motion::Skeleton target =
-      patient ? motion::skeleton_from_atlas(*patient) : *subject;
+  const motion::Skeleton target = patient ? motion::skeleton_from_atlas(*patient) : *subject;
   const std::string target_name = patient ? patient->name : subject_name;
   motion::Skeleton fitted = subject ? *subject : target;
 
@@ -275,8 +277,8 @@ void FuseMotion::run(workflow::NodeContext& context) {
   report["mapping"] = mapping.name.empty() ? mapping.source.string() : mapping.name;
   if (context.has_input("static_trial")) {
     context.progress(1, 5, "placing markers from the static trial");
-    const opensim::MarkerTrajectories standing = opensim::parse_trc(
-        context.input_bytes("static_trial"), context.input("static_trial").path);
+    const opensim::MarkerTrajectories standing =
+        opensim::parse_trc(context.input_bytes("static_trial"), context.input("static_trial").path);
     const motion::MarkerPlacement placed = motion::place_markers(fitted, standing, mapping);
     fitted = placed.skeleton;
     nlohmann::json moved = nlohmann::json::array();
@@ -328,7 +330,8 @@ void FuseMotion::run(workflow::NodeContext& context) {
 
   std::optional<opensim::StorageTable> reference;
   if (context.has_input("reference")) {
-    reference = opensim::parse_mot(context.input_bytes("reference"), context.input("reference").path);
+    reference =
+        opensim::parse_mot(context.input_bytes("reference"), context.input("reference").path);
     nlohmann::json table = nlohmann::json::array();
     for (const motion::CoordinateDifference& d : motion::compare_coordinates(fit, *reference)) {
       table.push_back({{"coordinate", d.coordinate},
@@ -342,9 +345,8 @@ void FuseMotion::run(workflow::NodeContext& context) {
   }
 
   context.progress(4, 5, "writing the outputs");
-  context.set_output("motion", motion::motion_to_json(result, target_name,
-                                                      patient ? "atlas" : "osim")
-                                   .dump());
+  context.set_output(
+      "motion", motion::motion_to_json(result, target_name, patient ? "atlas" : "osim").dump());
   const std::filesystem::path mot = context.scratch_dir() / "angles.mot";
   opensim::write_mot(motion::coordinate_table(result, target_name + "_ik"), mot);
   context.set_output_file("angles", mot);
@@ -354,11 +356,11 @@ void FuseMotion::run(workflow::NodeContext& context) {
   context.set_output("points", motion::point_trajectories_csv(points, result));
   motion::AnglePlotOptions plot_options;
   plot_options.title = "Joint angles: " + target_name + (reference ? " vs reference" : "");
-  context.set_output("plot", motion::joint_angle_svg(fit, reference ? &*reference : nullptr,
-                                                     plot_options));
-  context.set_output("animation", animation_bundle(context, target, result,
-                                                   patient ? &*patient : nullptr, atlas_dir,
-                                                   context.text("mesh_level")));
+  context.set_output("plot",
+                     motion::joint_angle_svg(fit, reference ? &*reference : nullptr, plot_options));
+  context.set_output("animation",
+                     animation_bundle(context, target, result, patient ? &*patient : nullptr,
+                                      atlas_dir, context.text("mesh_level")));
   report["seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   context.set_output("report", report.dump(2));

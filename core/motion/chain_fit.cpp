@@ -48,12 +48,11 @@ struct ChainFitter::Impl {
       }
     }
     for (const BoundCoordinateTask& task : setup.coordinates) {
-      const double scale =
-          std::sqrt(task.weight) *
-          (skeleton->coordinates[static_cast<std::size_t>(task.coordinate)].unit ==
-                   CoordinateUnit::kAngle
-               ? kAngleTaskScale
-               : kLengthTaskScale);
+      const double scale = std::sqrt(task.weight) *
+                           (skeleton->coordinates[static_cast<std::size_t>(task.coordinate)].unit ==
+                                    CoordinateUnit::kAngle
+                                ? kAngleTaskScale
+                                : kLengthTaskScale);
       r(row) = scale * (at(task.coordinate) - task.value);
       if (jacobian != nullptr) (*jacobian)(row, task.coordinate) = scale;
       ++row;
@@ -167,7 +166,8 @@ ChainFitter::ChainFitter(const Skeleton& skeleton, TrackingSetup setup, ChainFit
     const SkeletonCoordinate& coordinate = skeleton.coordinates[static_cast<std::size_t>(c)];
     if (coordinate.locked) {
       locked.push_back(c);
-    } else if (options.respect_limits && coordinate.clamped && coordinate.lower < coordinate.upper) {
+    } else if (options.respect_limits && coordinate.clamped &&
+               coordinate.lower < coordinate.upper) {
       s.problem->SetParameterLowerBound(block, c, coordinate.lower);
       s.problem->SetParameterUpperBound(block, c, coordinate.upper);
     }

@@ -34,9 +34,15 @@ class Reader {
     for (const auto& entry : map) {
       const auto key = entry.first.as<std::string>();
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-        fail(entry.first, field + "." + key,
-             "unknown key" + did_you_mean(key, allowed) + " (allowed: " + join_names(allowed) +
-                 ")");
+        std::string problem = "unknown key";
+        problem += did_you_mean(key, allowed);
+        problem += " (allowed: ";
+        problem += join_names(allowed);
+        problem += ")";
+        std::string where = field;
+        where += ".";
+        where += key;
+        fail(entry.first, where, problem);
       }
     }
   }

@@ -77,8 +77,7 @@ MarkerPlacement place_markers(const Skeleton& skeleton,
     double left = error;
     if (!marker.fixed || options.move_fixed) {
       if (error <= options.max_move_mm) {
-        const Eigen::Vector3d measured =
-            mean.unit_to_mm * mean.position(0, bound.trial);
+        const Eigen::Vector3d measured = mean.unit_to_mm * mean.position(0, bound.trial);
         marker.local = poses[static_cast<std::size_t>(marker.body)].inverse() * measured;
         placed.moved_mm = error;
         placed.moved = true;

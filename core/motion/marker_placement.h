@@ -32,10 +32,10 @@ struct PlacedMarker {
 };
 
 struct MarkerPlacement {
-  Skeleton skeleton;              // the input with its markers moved
-  Eigen::VectorXd static_pose;    // coordinates of the standing pose (rad, mm)
-  double rms_before_mm = 0.0;     // tracked markers at the standing pose, before moving
-  double rms_after_mm = 0.0;      // and after
+  Skeleton skeleton;                  // the input with its markers moved
+  Eigen::VectorXd static_pose;        // coordinates of the standing pose (rad, mm)
+  double rms_before_mm = 0.0;         // tracked markers at the standing pose, before moving
+  double rms_after_mm = 0.0;          // and after
   std::vector<PlacedMarker> markers;  // every tracked marker
   int frames_averaged = 0;
   std::vector<std::string> notes;

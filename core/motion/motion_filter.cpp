@@ -23,8 +23,8 @@ ChainPrior MotionFilter::predict(double dt, const Eigen::VectorXd& start) {
     x_predicted_.head(n_) = start;
     p_predicted_ = Eigen::MatrixXd::Zero(m, m);
     for (int c = 0; c < n_; ++c) {
-      const bool angle = skeleton_->coordinates[static_cast<std::size_t>(c)].unit ==
-                         CoordinateUnit::kAngle;
+      const bool angle =
+          skeleton_->coordinates[static_cast<std::size_t>(c)].unit == CoordinateUnit::kAngle;
       const double sd = angle ? options_.initial_angle_sd : options_.initial_length_sd;
       const double vsd =
           angle ? options_.initial_angular_velocity_sd : options_.initial_linear_velocity_sd;
@@ -38,8 +38,8 @@ ChainPrior MotionFilter::predict(double dt, const Eigen::VectorXd& start) {
     f_.topRightCorner(n_, n_) = dt * Eigen::MatrixXd::Identity(n_, n_);
     Eigen::MatrixXd q = Eigen::MatrixXd::Zero(m, m);
     for (int c = 0; c < n_; ++c) {
-      const bool angle = skeleton_->coordinates[static_cast<std::size_t>(c)].unit ==
-                         CoordinateUnit::kAngle;
+      const bool angle =
+          skeleton_->coordinates[static_cast<std::size_t>(c)].unit == CoordinateUnit::kAngle;
       const double sd = angle ? options_.angular_acceleration_sd : options_.linear_acceleration_sd;
       const double s2 = sd * sd;
       q(c, c) = s2 * dt * dt * dt / 3.0;

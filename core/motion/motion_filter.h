@@ -37,11 +37,11 @@ struct MotionFilterOptions {
   // OpenSim's unfiltered IK, bench/run motion): 30 moves no leg angle by
   // more than 0.05 degree RMS while halving synthetic 3 mm marker noise.
   double angular_acceleration_sd = 30.0;
-  double linear_acceleration_sd = 3000.0;   // sigma_a, mm/s^2 per sqrt(Hz)
-  double marker_noise_mm = 5.0;             // sigma_m of a weight-1 marker
-  double initial_angle_sd = 1.0;            // rad, before the first frame
-  double initial_length_sd = 1000.0;        // mm
-  double initial_angular_velocity_sd = 10;  // rad/s
+  double linear_acceleration_sd = 3000.0;    // sigma_a, mm/s^2 per sqrt(Hz)
+  double marker_noise_mm = 5.0;              // sigma_m of a weight-1 marker
+  double initial_angle_sd = 1.0;             // rad, before the first frame
+  double initial_length_sd = 1000.0;         // mm
+  double initial_angular_velocity_sd = 10;   // rad/s
   double initial_linear_velocity_sd = 5000;  // mm/s
 };
 

@@ -31,13 +31,12 @@ std::vector<int> frames_in_range(const opensim::MarkerTrajectories& trial,
     if (trial.times(f) >= start && trial.times(f) <= end) frames.push_back(static_cast<int>(f));
   }
   if (frames.empty()) {
-    throw InvalidInputError(trial.source.string() + ": no frame between " +
-                            std::to_string(options.start_time.value_or(trial.times(0))) +
-                            " s and " +
-                            std::to_string(options.end_time.value_or(
-                                trial.times(trial.num_frames() - 1))) +
-                            " s (the trial spans " + std::to_string(trial.times(0)) + " to " +
-                            std::to_string(trial.times(trial.num_frames() - 1)) + " s)");
+    throw InvalidInputError(
+        trial.source.string() + ": no frame between " +
+        std::to_string(options.start_time.value_or(trial.times(0))) + " s and " +
+        std::to_string(options.end_time.value_or(trial.times(trial.num_frames() - 1))) +
+        " s (the trial spans " + std::to_string(trial.times(0)) + " to " +
+        std::to_string(trial.times(trial.num_frames() - 1)) + " s)");
   }
   return frames;
 }
@@ -66,7 +65,8 @@ std::vector<FreeBody> register_bodies(const Skeleton& skeleton, const TrackingSe
   for (std::size_t b = 0; b < skeleton.bodies.size(); ++b) {
     std::vector<Eigen::Index> rows;
     for (std::size_t i = 0; i < setup.markers.size(); ++i) {
-      const SkeletonMarker& marker = skeleton.markers[static_cast<std::size_t>(setup.markers[i].model)];
+      const SkeletonMarker& marker =
+          skeleton.markers[static_cast<std::size_t>(setup.markers[i].model)];
       if (marker.body == static_cast<int>(b) &&
           targets.row(static_cast<Eigen::Index>(i)).allFinite()) {
         rows.push_back(static_cast<Eigen::Index>(i));
@@ -78,7 +78,8 @@ std::vector<FreeBody> register_bodies(const Skeleton& skeleton, const TrackingSe
     Eigen::MatrixX3d target(count, 3);
     Eigen::VectorXd weights(count);
     for (Eigen::Index k = 0; k < count; ++k) {
-      const BoundMarker& bound = setup.markers[static_cast<std::size_t>(rows[static_cast<std::size_t>(k)])];
+      const BoundMarker& bound =
+          setup.markers[static_cast<std::size_t>(rows[static_cast<std::size_t>(k)])];
       source.row(k) = skeleton.markers[static_cast<std::size_t>(bound.model)].local.transpose();
       target.row(k) = targets.row(rows[static_cast<std::size_t>(k)]);
       weights(k) = bound.weight;
@@ -102,18 +103,17 @@ Eigen::VectorXd root_start(const Skeleton& skeleton, const Eigen::Isometry3d& ta
   std::vector<int> free;
   std::vector<int> rotations;
   for (const SkeletonAxis& axis : skeleton.bodies.front().axes) {
-    if (axis.coordinate < 0 ||
-        std::find(free.begin(), free.end(), axis.coordinate) != free.end()) {
+    if (axis.coordinate < 0 || std::find(free.begin(), free.end(), axis.coordinate) != free.end()) {
       continue;
     }
     free.push_back(axis.coordinate);
     if (axis.rotation) rotations.push_back(axis.coordinate);
   }
   if (free.empty()) return q;
-  const std::vector<Eigen::Vector3d> points = {
-      centre_local, centre_local + 100.0 * Eigen::Vector3d::UnitX(),
-      centre_local + 100.0 * Eigen::Vector3d::UnitY(),
-      centre_local + 100.0 * Eigen::Vector3d::UnitZ()};
+  const std::vector<Eigen::Vector3d> points = {centre_local,
+                                               centre_local + 100.0 * Eigen::Vector3d::UnitX(),
+                                               centre_local + 100.0 * Eigen::Vector3d::UnitY(),
+                                               centre_local + 100.0 * Eigen::Vector3d::UnitZ()};
   SkeletonPose pose(skeleton);
   const auto cost_and_step = [&](const Eigen::VectorXd& at, Eigen::VectorXd* step) {
     pose.set(at);
@@ -265,7 +265,8 @@ FusedMotion fuse_motion(const Skeleton& skeleton, const opensim::MarkerTrajector
     placed = true;
   }
   if (!placed) {
-    throw InvalidInputError(trial.source.string() + ": no frame in the range has 3 of the root "
+    throw InvalidInputError(trial.source.string() +
+                            ": no frame in the range has 3 of the root "
                             "body's tracked markers (" +
                             skeleton.bodies.front().name +
                             "); its pose cannot be started (check the marker mapping)");
@@ -294,11 +295,10 @@ FusedMotion fuse_motion(const Skeleton& skeleton, const opensim::MarkerTrajector
     if (filter) filter->update(fit);
     if (!fit.converged) ++unconverged;
     if (fit.markers_used == 0) {
-      motion.notes.push_back("frame " + std::to_string(frames[static_cast<std::size_t>(k)] + 1) +
-                             " (t = " + std::to_string(motion.times(k)) +
-                             " s): no tracked marker present; " +
-                             (filter ? "the filter's prediction is used"
-                                     : "the previous frame's pose is kept"));
+      motion.notes.push_back(
+          "frame " + std::to_string(frames[static_cast<std::size_t>(k)] + 1) +
+          " (t = " + std::to_string(motion.times(k)) + " s): no tracked marker present; " +
+          (filter ? "the filter's prediction is used" : "the previous frame's pose is kept"));
     }
     motion.coordinates.row(k) = fit.q.transpose();
     motion.iterations(k) = fit.iterations;
@@ -317,8 +317,8 @@ FusedMotion fuse_motion(const Skeleton& skeleton, const opensim::MarkerTrajector
   motion.max_mm.resize(count);
   motion.markers_used.resize(count);
   for (Eigen::Index k = 0; k < count; ++k) {
-    const ChainFitResult at =
-        fitter.evaluate(targets[static_cast<std::size_t>(k)], motion.coordinates.row(k).transpose());
+    const ChainFitResult at = fitter.evaluate(targets[static_cast<std::size_t>(k)],
+                                              motion.coordinates.row(k).transpose());
     motion.marker_errors.row(k) = at.marker_errors.transpose();
     motion.rms_mm(k) = at.rms_mm;
     motion.max_mm(k) = at.max_mm;

@@ -42,23 +42,23 @@ struct MotionFusionOptions {
 // registrations would pull the joint apart (medians over the frames).
 struct BodyRegistrationSummary {
   std::string body;
-  int frames_registered = 0;        // frames with >= 3 of its markers present
-  double cluster_rms_mm = 0.0;      // median of the Kabsch RMS residual
-  double joint_gap_mm = 0.0;        // median distance between the joint centre as the free
-                                    // parent and the free child place it (NaN: no parent pair)
+  int frames_registered = 0;    // frames with >= 3 of its markers present
+  double cluster_rms_mm = 0.0;  // median of the Kabsch RMS residual
+  double joint_gap_mm = 0.0;    // median distance between the joint centre as the free
+                                // parent and the free child place it (NaN: no parent pair)
 };
 
 struct FusedMotion {
   std::vector<std::string> coordinate_names;
   std::vector<CoordinateUnit> coordinate_units;
   std::vector<std::string> body_names;
-  std::vector<std::string> marker_names;  // tracked model markers, as columns below
-  Eigen::VectorXd times;                  // #frames (s)
-  std::vector<int> trial_frames;          // #frames, 0-based rows of the trial
-  Eigen::MatrixXd coordinates;            // #frames by #coordinates (rad, mm)
+  std::vector<std::string> marker_names;              // tracked model markers, as columns below
+  Eigen::VectorXd times;                              // #frames (s)
+  std::vector<int> trial_frames;                      // #frames, 0-based rows of the trial
+  Eigen::MatrixXd coordinates;                        // #frames by #coordinates (rad, mm)
   std::vector<std::vector<Eigen::Isometry3d>> poses;  // [frame][body], body -> world (mm)
-  Eigen::MatrixXd marker_errors;  // #frames by #markers (mm); NaN where missing
-  Eigen::VectorXd rms_mm;         // #frames, over the markers present
+  Eigen::MatrixXd marker_errors;                      // #frames by #markers (mm); NaN where missing
+  Eigen::VectorXd rms_mm;                             // #frames, over the markers present
   Eigen::VectorXd max_mm;
   Eigen::VectorXi markers_used;
   Eigen::VectorXi iterations;   // chain-fit iterations per frame

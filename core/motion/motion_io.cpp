@@ -57,7 +57,8 @@ nlohmann::json motion_to_json(const FusedMotion& motion, const std::string& mode
   json["frame"] = model_kind == "atlas"
                       ? "poses map the atlas's rest-pose frame (mm) to the trial's lab (mm)"
                       : "poses map each OpenSim body frame (mm) to the trial's lab (mm)";
-  json["times"] = std::vector<double>(motion.times.data(), motion.times.data() + motion.times.size());
+  json["times"] =
+      std::vector<double>(motion.times.data(), motion.times.data() + motion.times.size());
   json["trial_frames"] = motion.trial_frames;
   nlohmann::json units = nlohmann::json::array();
   for (const CoordinateUnit unit : motion.coordinate_units) {
@@ -91,7 +92,7 @@ nlohmann::json motion_to_json(const FusedMotion& motion, const std::string& mode
 
 FusedMotion motion_from_json(const nlohmann::json& json, std::string_view what) {
   if (!json.is_object() || json.value("format", "") != kFormat) {
-    fail(what, "not a fused motion (expected \"format\": \"" + std::string(kFormat) + "\")");
+    fail(what, R"(not a fused motion (expected "format": ")" + std::string(kFormat) + R"("))");
   }
   FusedMotion motion;
   const nlohmann::json& times = field(json, "times", what, "");
@@ -99,7 +100,8 @@ FusedMotion motion_from_json(const nlohmann::json& json, std::string_view what) 
   const auto frames = static_cast<Eigen::Index>(times.size());
   motion.times.resize(frames);
   for (Eigen::Index k = 0; k < frames; ++k) {
-    motion.times(k) = number(times[static_cast<std::size_t>(k)], what, "times[" + std::to_string(k) + "]");
+    motion.times(k) =
+        number(times[static_cast<std::size_t>(k)], what, "times[" + std::to_string(k) + "]");
   }
   const nlohmann::json& trial_frames = field(json, "trial_frames", what, "");
   if (!trial_frames.is_array() || static_cast<Eigen::Index>(trial_frames.size()) != frames) {
@@ -107,8 +109,8 @@ FusedMotion motion_from_json(const nlohmann::json& json, std::string_view what) 
   }
   for (const nlohmann::json& f : trial_frames) motion.trial_frames.push_back(f.get<int>());
   const nlohmann::json& coordinates = field(json, "coordinates", what, "");
-  motion.coordinate_names = names(field(coordinates, "names", what, "coordinates."), what,
-                                  "coordinates.names");
+  motion.coordinate_names =
+      names(field(coordinates, "names", what, "coordinates."), what, "coordinates.names");
   const std::vector<std::string> units =
       names(field(coordinates, "units", what, "coordinates."), what, "coordinates.units");
   if (units.size() != motion.coordinate_names.size()) {

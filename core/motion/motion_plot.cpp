@@ -27,8 +27,7 @@ std::string joint_angle_svg(const FusedMotion& motion, const opensim::StorageTab
     if (reference != nullptr) {
       if (const auto index = reference->column_index(motion.coordinate_names[c])) {
         plot::Series theirs{options.reference_label, {}, {}, "", true, 1.5};
-        const double their_unit =
-            angle ? (reference->in_degrees ? 1.0 : kDeg) : 1000.0;  // m -> mm
+        const double their_unit = angle ? (reference->in_degrees ? 1.0 : kDeg) : 1000.0;  // m -> mm
         for (Eigen::Index r = 0; r < reference->num_rows(); ++r) {
           const double t = reference->times(r);
           if (t < times.front() - 1e-9 || t > times.back() + 1e-9) continue;

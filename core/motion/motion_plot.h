@@ -13,8 +13,8 @@ struct AnglePlotOptions {
   std::string title;
   std::string ours_label = "mmm";
   std::string reference_label = "OpenSim IK";
-  bool angles_only = true;        // leave out translations
-  double min_range_deg = 0.5;     // leave out coordinates that barely move
+  bool angles_only = true;     // leave out translations
+  double min_range_deg = 0.5;  // leave out coordinates that barely move
   int columns = 3;
 };
 

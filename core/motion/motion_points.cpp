@@ -17,6 +17,11 @@ int body_of(const Skeleton& skeleton, const std::string& bone, const std::string
   return *index;
 }
 
+InvalidInputError unknown_coordinate(const std::string& what, const std::string& coordinate) {
+  return InvalidInputError{what + ": coordinate '" + coordinate +
+                           "' is not one of the motion's coordinates"};
+}
+
 std::string csv_field(const std::string& text) {
   if (text.find_first_of(",\"\n") == std::string::npos) return text;
   std::string quoted = "\"";
@@ -43,7 +48,7 @@ PointTrajectories atlas_point_trajectories(const atlas::Atlas& atlas, const Skel
                                            const FusedMotion& motion) {
   PointTrajectories result;
   std::vector<Rule> rules;
-  const auto add = [&](TrackedPoint point, Rule rule) {
+  const auto add = [&](TrackedPoint point, const Rule& rule) {
     result.points.push_back(std::move(point));
     rules.push_back(rule);
   };
@@ -73,7 +78,7 @@ PointTrajectories atlas_point_trajectories(const atlas::Atlas& atlas, const Skel
         }
         if (point.kind == atlas::PathPointKind::kConditional) {
           const std::optional<int> c = motion.coordinate_index(point.coordinate);
-          if (!c) throw InvalidInputError(what + ": coordinate '" + point.coordinate + "' unknown");
+          if (!c) throw unknown_coordinate(what, point.coordinate);
           rule.condition = *c;
         }
         if (point.kind == atlas::PathPointKind::kMoving) {
@@ -81,7 +86,7 @@ PointTrajectories atlas_point_trajectories(const atlas::Atlas& atlas, const Skel
             const std::string& name = point.moving_coordinates[static_cast<std::size_t>(k)];
             if (name.empty()) continue;
             const std::optional<int> c = motion.coordinate_index(name);
-            if (!c) throw InvalidInputError(what + ": coordinate '" + name + "' unknown");
+            if (!c) throw unknown_coordinate(what, name);
             rule.moving[static_cast<std::size_t>(k)] = *c;
           }
         }

@@ -50,9 +50,9 @@ std::vector<CoordinateDifference> compare_coordinates(const FusedMotion& motion,
       const double clamped = std::clamp(t, first, last);
       const double theirs_raw = reference.interpolate(clamped)(*column);
       const double theirs = difference.angle ? theirs_raw * angle_unit : theirs_raw / kMPerMm;
-      const double ours = difference.angle ? motion.coordinates(k, static_cast<Eigen::Index>(c)) *
-                                                 kDegPerRad
-                                           : motion.coordinates(k, static_cast<Eigen::Index>(c));
+      const double ours = difference.angle
+                              ? motion.coordinates(k, static_cast<Eigen::Index>(c)) * kDegPerRad
+                              : motion.coordinates(k, static_cast<Eigen::Index>(c));
       if (!std::isfinite(theirs)) continue;
       const double d = ours - theirs;
       squares += d * d;

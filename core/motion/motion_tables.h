@@ -17,11 +17,11 @@ opensim::StorageTable coordinate_table(const FusedMotion& motion, const std::str
 
 struct CoordinateDifference {
   std::string coordinate;
-  bool angle = true;       // deg; else mm
-  int samples = 0;         // frames compared
-  double rms = 0.0;        // RMS of ours - reference (deg or mm)
+  bool angle = true;  // deg; else mm
+  int samples = 0;    // frames compared
+  double rms = 0.0;   // RMS of ours - reference (deg or mm)
   double max_abs = 0.0;
-  double mean = 0.0;       // mean offset (deg or mm)
+  double mean = 0.0;             // mean offset (deg or mm)
   double reference_range = 0.0;  // max - min of the reference over the frames
 };
 

@@ -81,7 +81,7 @@ Retargeted retarget_motion(const FusedMotion& source, const Skeleton& source_ske
   if (source_leg && target_leg && *source_leg > 0) {
     result.leg_length_ratio = *target_leg / *source_leg;
   } else {
-    result.notes.push_back(
+    result.notes.emplace_back(
         "leg lengths not measurable on both models (hip_flexion/knee_angle/ankle_angle joints); "
         "root translations copied unscaled");
   }
@@ -119,8 +119,9 @@ Retargeted retarget_motion(const FusedMotion& source, const Skeleton& source_ske
     coordinates.col(*vertical).array() += result.vertical_shift_mm;
     target_feet.array() += result.vertical_shift_mm;
   } else if (options.keep_ground_contact) {
-    result.notes.push_back("ground contact not adjusted: no foot markers or no vertical root "
-                           "translation on one of the models");
+    result.notes.emplace_back(
+        "ground contact not adjusted: no foot markers or no vertical root "
+        "translation on one of the models");
   }
   result.target_foot_min_mm = target_feet.minCoeff();
   result.target_foot_max_mm = target_feet.maxCoeff();
@@ -149,10 +150,10 @@ Retargeted retarget_motion(const FusedMotion& source, const Skeleton& source_ske
     Eigen::MatrixX3d targets(static_cast<Eigen::Index>(motion.setup.markers.size()), 3);
     for (std::size_t i = 0; i < motion.setup.markers.size(); ++i) {
       targets.row(static_cast<Eigen::Index>(i)) =
-          trial.unit_to_mm *
-          trial.position(source.trial_frames[static_cast<std::size_t>(k)],
-                         motion.setup.markers[i].trial)
-              .transpose();
+          trial.unit_to_mm * trial
+                                 .position(source.trial_frames[static_cast<std::size_t>(k)],
+                                           motion.setup.markers[i].trial)
+                                 .transpose();
     }
     const ChainFitResult at = evaluator.evaluate(targets, coordinates.row(k).transpose());
     motion.marker_errors.row(k) = at.marker_errors.transpose();

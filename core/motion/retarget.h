@@ -27,7 +27,7 @@ struct RetargetOptions {
 };
 
 struct Retargeted {
-  FusedMotion motion;  // of the target skeleton; marker errors against the trial
+  FusedMotion motion;             // of the target skeleton; marker errors against the trial
   double leg_length_ratio = 1.0;  // target / source
   double vertical_shift_mm = 0.0;
   std::vector<std::string> transferred;  // coordinates copied (scaled for lengths)

@@ -110,7 +110,7 @@ SkeletonCoordinate atlas_coordinate(const atlas::Coordinate& source) {
   SkeletonCoordinate coordinate;
   coordinate.name = source.name;
   coordinate.unit = source.kind == atlas::CoordinateKind::kTranslational ? CoordinateUnit::kLength
-                                                                          : CoordinateUnit::kAngle;
+                                                                         : CoordinateUnit::kAngle;
   coordinate.lower = source.range[0];
   coordinate.upper = source.range[1];
   coordinate.default_value = source.default_value;
@@ -287,8 +287,8 @@ Skeleton skeleton_from_atlas(const atlas::Atlas& atlas) {
           {root + "_tilt", CoordinateUnit::kAngle, -half_pi, half_pi, false, false, 0.0});
       skeleton.coordinates.push_back(
           {root + "_list", CoordinateUnit::kAngle, -half_pi, half_pi, false, false, 0.0});
-      skeleton.coordinates.push_back({root + "_rotation", CoordinateUnit::kAngle,
-                                      -std::numbers::pi, std::numbers::pi, false, false, 0.0});
+      skeleton.coordinates.push_back({root + "_rotation", CoordinateUnit::kAngle, -std::numbers::pi,
+                                      std::numbers::pi, false, false, 0.0});
       for (const char* axis : {"_tx", "_ty", "_tz"}) {
         skeleton.coordinates.push_back(
             {root + axis, CoordinateUnit::kLength, -1e4, 1e4, false, false, 0.0});
@@ -399,9 +399,9 @@ void SkeletonPose::add_point_jacobian(int body, const Eigen::Vector3d& world_poi
   for (int b = body; b >= 0; b = skeleton_->bodies[body_i(b)].parent) {
     for (const WorldAxis& axis : axes_[body_i(b)]) {
       if (axis.coordinate < 0 || axis.rate == 0.0) continue;
-      const Eigen::Vector3d velocity = axis.rotation
-                                           ? Eigen::Vector3d(axis.direction.cross(world_point - axis.origin))
-                                           : axis.direction;
+      const Eigen::Vector3d velocity =
+          axis.rotation ? Eigen::Vector3d(axis.direction.cross(world_point - axis.origin))
+                        : axis.direction;
       jacobian.block<3, 1>(row, axis.coordinate) += weight * axis.rate * velocity;
     }
   }

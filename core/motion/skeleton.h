@@ -79,7 +79,7 @@ struct SkeletonMarker {
   std::string name;
   int body = 0;
   Eigen::Vector3d local = Eigen::Vector3d::Zero();  // in the body (mm)
-  bool fixed = false;  // OpenSim: not moved by marker placement
+  bool fixed = false;                               // OpenSim: not moved by marker placement
 };
 
 struct Skeleton {

@@ -52,8 +52,9 @@ TrackingSetup bind_tracking(const Skeleton& skeleton, const MarkerMapping& mappi
   }
   int on_root = 0;
   for (const BoundMarker& marker : setup.markers) {
-    if (skeleton.bodies[static_cast<std::size_t>(
-                            skeleton.markers[static_cast<std::size_t>(marker.model)].body)]
+    if (skeleton
+            .bodies[static_cast<std::size_t>(
+                skeleton.markers[static_cast<std::size_t>(marker.model)].body)]
             .parent < 0) {
       ++on_root;
     }

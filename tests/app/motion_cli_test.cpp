@@ -27,10 +27,10 @@ TEST(MotionCliTest, TheWalkThroughOpenSimsModelAgreesWithOpenSimAndIsExported) {
   const fs::path study = dir / "walk";
   const CommandResult created = run_mmm(
       "study create " + study.string() + " -w " +
-      (test::source_dir() / "schemas/examples/motion_fusion.yaml").string() + " --input model=" +
-      (pipelines() / "reference" / "subject01_simbody.osim").string() + " --input trial=" +
-      (pipelines() / "subject01_walk1.trc").string() + " --input reference=" +
-      (pipelines() / "reference" / "subject01_walk1_ik.mot").string());
+      (test::source_dir() / "schemas/examples/motion_fusion.yaml").string() +
+      " --input model=" + (pipelines() / "reference" / "subject01_simbody.osim").string() +
+      " --input trial=" + (pipelines() / "subject01_walk1.trc").string() +
+      " --input reference=" + (pipelines() / "reference" / "subject01_walk1_ik.mot").string());
   ASSERT_EQ(created.exit_code, 0) << created.err;
   const CommandResult ran = run_mmm("run " + study.string() + " -q");
   ASSERT_EQ(ran.exit_code, 0) << ran.out << ran.err;

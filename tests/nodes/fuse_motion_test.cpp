@@ -24,9 +24,7 @@ namespace {
 
 using workflow::PortType;
 
-std::filesystem::path pipelines() {
-  return mmm::test::data_dir() / "gait2392" / "Pipelines";
-}
+std::filesystem::path pipelines() { return mmm::test::data_dir() / "gait2392" / "Pipelines"; }
 
 workflow::ArtifactRef add_file(test::NodeHarness& harness, const std::filesystem::path& file) {
   return harness.add(PortType::kFile, mmm::test::read_text(file));
@@ -39,7 +37,8 @@ TEST(FuseMotionNodeTest, DrivesOpenSimsSubjectModelAsOpenSimDoes) {
        {"trial", add_file(harness, pipelines() / "subject01_walk1.trc")},
        {"reference", add_file(harness, pipelines() / "reference" / "subject01_walk1_ik.mot")}},
       {{"start_time", 0.5}, {"end_time", 1.0}, {"filter", std::string("none")}});
-  const nlohmann::json report = nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+  const nlohmann::json report =
+      nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
   EXPECT_EQ(report["fit"]["frames"], 31);  // 0.5-1.0 s at 60 Hz
   int compared = 0;
   for (const nlohmann::json& row : report["reference_comparison"]) {
@@ -87,7 +86,8 @@ TEST(FuseMotionNodeTest, RetargetsTheSubjectsMotionToAPatientAtlas) {
        {"model", add_file(harness, pipelines() / "reference" / "subject01_simbody.osim")},
        {"trial", add_file(harness, pipelines() / "subject01_walk1.trc")}},
       {{"start_time", 0.5}, {"end_time", 0.7}, {"mesh_level", std::string("lod1")}});
-  const nlohmann::json report = nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+  const nlohmann::json report =
+      nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
   ASSERT_TRUE(report.contains("retargeting"));
   const std::vector<std::string> transferred = report["retargeting"]["transferred"];
   EXPECT_NE(std::find(transferred.begin(), transferred.end(), "knee_angle_r"), transferred.end());

@@ -10,8 +10,8 @@
 namespace mmm::test {
 
 const motion::Skeleton& subject01_skeleton() {
-  static const motion::Skeleton skeleton = motion::skeleton_from_osim(
-      opensim::read_osim(data_dir() / "gait2392" / "Pipelines" / "reference" / "subject01_simbody.osim"));
+  static const motion::Skeleton skeleton = motion::skeleton_from_osim(opensim::read_osim(
+      data_dir() / "gait2392" / "Pipelines" / "reference" / "subject01_simbody.osim"));
   return skeleton;
 }
 
@@ -21,10 +21,9 @@ namespace {
 // marker trial can tell its value).
 bool moves_a_marker(const motion::Skeleton& skeleton, int coordinate) {
   const std::vector<int> moved = skeleton.bodies_moved_by(coordinate);
-  for (const motion::SkeletonMarker& marker : skeleton.markers) {
-    if (std::find(moved.begin(), moved.end(), marker.body) != moved.end()) return true;
-  }
-  return false;
+  return std::ranges::any_of(skeleton.markers, [&](const motion::SkeletonMarker& marker) {
+    return std::find(moved.begin(), moved.end(), marker.body) != moved.end();
+  });
 }
 
 }  // namespace
@@ -32,13 +31,14 @@ bool moves_a_marker(const motion::Skeleton& skeleton, int coordinate) {
 Eigen::MatrixXd synthetic_coordinates(const motion::Skeleton& skeleton, int frames) {
   Eigen::MatrixXd q(frames, skeleton.num_coordinates());
   for (int c = 0; c < skeleton.num_coordinates(); ++c) {
-    const motion::SkeletonCoordinate& coordinate = skeleton.coordinates[static_cast<std::size_t>(c)];
+    const motion::SkeletonCoordinate& coordinate =
+        skeleton.coordinates[static_cast<std::size_t>(c)];
     const bool length = coordinate.unit == motion::CoordinateUnit::kLength;
     // Gait-like: 20 degrees (or 20 mm), one cycle per second, each
     // coordinate with its own phase; kept well inside its range.
     const double half_range = 0.5 * (coordinate.upper - coordinate.lower);
-    const double amplitude = std::min(length ? 20.0 : 20.0 * std::numbers::pi / 180.0,
-                                      0.4 * std::max(half_range, 0.0));
+    const double amplitude =
+        std::min(length ? 20.0 : 20.0 * std::numbers::pi / 180.0, 0.4 * std::max(half_range, 0.0));
     const double centre = std::clamp(coordinate.default_value, coordinate.lower + amplitude,
                                      coordinate.upper - amplitude);
     for (int f = 0; f < frames; ++f) {

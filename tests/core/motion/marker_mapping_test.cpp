@@ -59,8 +59,9 @@ TEST(MarkerMappingTest, BadFilesNameTheLineFieldAndAHint) {
   EXPECT_NE(weight.find("markers[0].weight"), std::string::npos) << weight;
   EXPECT_NE(error_of("mmm_marker_mapping: 1\nmarkers: [{trial: A}, {trial: A}]").find("twice"),
             std::string::npos);
-  EXPECT_NE(error_of("mmm_marker_mapping: 1\nmarkers: [{trial: A, weight: 0}]").find("every weight"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("mmm_marker_mapping: 1\nmarkers: [{trial: A, weight: 0}]").find("every weight"),
+      std::string::npos);
   EXPECT_NE(error_of("mmm_marker_mapping: 1\nmarkers: [{model: A}]").find("trial: is required"),
             std::string::npos);
   EXPECT_THROW(read_marker_mapping("/nonexistent/mapping.yaml"), IoError);

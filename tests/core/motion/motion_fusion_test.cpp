@@ -21,12 +21,12 @@ namespace {
 constexpr double kDeg = 180.0 / std::numbers::pi;
 
 // Every free coordinate's worst error against the truth (deg, or mm).
-double worst_error(const Skeleton& skeleton, const Eigen::MatrixXd& truth,
-                   const FusedMotion& fused, bool lengths) {
+double worst_error(const Skeleton& skeleton, const Eigen::MatrixXd& truth, const FusedMotion& fused,
+                   bool lengths) {
   double worst = 0;
   for (int c = 0; c < skeleton.num_coordinates(); ++c) {
-    const bool length = skeleton.coordinates[static_cast<std::size_t>(c)].unit ==
-                        CoordinateUnit::kLength;
+    const bool length =
+        skeleton.coordinates[static_cast<std::size_t>(c)].unit == CoordinateUnit::kLength;
     if (length != lengths) continue;
     const double unit = length ? 1.0 : kDeg;
     worst = std::max(worst, unit * (fused.coordinates.col(c) - truth.col(c)).cwiseAbs().maxCoeff());
@@ -87,9 +87,7 @@ TEST(MotionFusionTest, GapsAndNanFramesLowerTheWeightInsteadOfFailing) {
   const Skeleton& skeleton = test::subject01_skeleton();
   const Eigen::MatrixXd truth = test::synthetic_coordinates(skeleton, 60);
   opensim::MarkerTrajectories trial = test::synthetic_trial(skeleton, truth);
-  const auto column = [&](const char* name) {
-    return 3 * *trial.marker_index(name);
-  };
+  const auto column = [&](const char* name) { return 3 * *trial.marker_index(name); };
   // A gap: the whole right shank cluster missing for frames 20-29, and one
   // frame (40) with no marker at all.
   for (const char* name : {"R.Shank.Upper", "R.Shank.Front", "R.Shank.Rear"}) {
@@ -103,14 +101,16 @@ TEST(MotionFusionTest, GapsAndNanFramesLowerTheWeightInsteadOfFailing) {
   EXPECT_EQ(fused.markers_used(40), 0);
   EXPECT_TRUE(fused.coordinates.allFinite());
   bool noted = false;
-  for (const std::string& note : fused.notes) noted = noted || note.find("frame 41") != std::string::npos;
+  for (const std::string& note : fused.notes)
+    noted = noted || note.find("frame 41") != std::string::npos;
   EXPECT_TRUE(noted);
   // The knee stays determined through the gap by the other markers (the
   // knee and ankle markers remain); the empty frame is bridged by the
   // filter: within a degree of the truth (20 degrees at 1 Hz turn < 2
   // degrees per frame, the smoother interpolates between its neighbours).
   const int knee = *skeleton.coordinate_index("knee_angle_r");
-  for (int f = 20; f < 30; ++f) EXPECT_NEAR(kDeg * fused.coordinates(f, knee), kDeg * truth(f, knee), 0.1);
+  for (int f = 20; f < 30; ++f)
+    EXPECT_NEAR(kDeg * fused.coordinates(f, knee), kDeg * truth(f, knee), 0.1);
   EXPECT_NEAR(kDeg * fused.coordinates(40, knee), kDeg * truth(40, knee), 1.0);
 }
 
@@ -201,8 +201,7 @@ TEST(MotionFusionTest, TimeRangeOutsideTheTrialIsNamed) {
 
 TEST(MotionFusionTest, MarkerPlacementPutsMarkersWhereTheyWereMeasured) {
   const Skeleton& truth_skeleton = test::subject01_skeleton();
-  const Eigen::MatrixXd standing =
-      test::synthetic_coordinates(truth_skeleton, 1).replicate(20, 1);
+  const Eigen::MatrixXd standing = test::synthetic_coordinates(truth_skeleton, 1).replicate(20, 1);
   const opensim::MarkerTrajectories static_trial = test::synthetic_trial(truth_skeleton, standing);
   // The model's thigh markers are 15 mm off where the subject wore them.
   Skeleton model = truth_skeleton;
@@ -251,8 +250,9 @@ TEST(MotionFusionTest, RetargetingOntoTheSameModelChangesNothingAndScalesTransla
   const int tx = *skeleton.coordinate_index("pelvis_tx");
   EXPECT_LT((big.motion.coordinates.col(hip) - fused.coordinates.col(hip)).cwiseAbs().maxCoeff(),
             1e-12);
-  EXPECT_LT((big.motion.coordinates.col(tx) - 1.1 * fused.coordinates.col(tx)).cwiseAbs().maxCoeff(),
-            1e-9);
+  EXPECT_LT(
+      (big.motion.coordinates.col(tx) - 1.1 * fused.coordinates.col(tx)).cwiseAbs().maxCoeff(),
+      1e-9);
   EXPECT_NEAR(big.target_foot_min_mm, big.source_foot_min_mm, 1e-9);
 }
 

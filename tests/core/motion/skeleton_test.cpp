@@ -25,8 +25,8 @@ Eigen::VectorXd random_pose(const Skeleton& skeleton, std::mt19937& random) {
 }
 
 TEST(SkeletonTest, OsimSkeletonPlacesBodiesAsOpenSimKinematicsDoes) {
-  const opensim::OsimModel model = opensim::read_osim(
-      test::data_dir() / "gait2392" / "Pipelines" / "reference" / "subject01_simbody.osim");
+  const opensim::OsimModel model = opensim::read_osim(test::data_dir() / "gait2392" / "Pipelines" /
+                                                      "reference" / "subject01_simbody.osim");
   const Skeleton skeleton = skeleton_from_osim(model);
   EXPECT_EQ(skeleton.bodies.size(), 12u);  // gait2392: every body but the ground
   EXPECT_EQ(skeleton.num_coordinates(), 23);
@@ -70,7 +70,7 @@ TEST(SkeletonTest, JacobianMatchesCentralDifferences) {
     for (int c = 0; c < skeleton.num_coordinates(); ++c) {
       const double h =
           skeleton.coordinates[static_cast<std::size_t>(c)].unit == CoordinateUnit::kLength ? 1e-3
-                                                                                          : 1e-6;
+                                                                                            : 1e-6;
       Eigen::VectorXd plus = q;
       Eigen::VectorXd minus = q;
       plus(c) += h;
