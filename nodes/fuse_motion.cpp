@@ -321,6 +321,7 @@ void FuseMotion::run(workflow::NodeContext& context) {
         {"subject_foot_height_mm", {retargeted.source_foot_min_mm, retargeted.source_foot_max_mm}},
         {"patient_foot_height_mm", {retargeted.target_foot_min_mm, retargeted.target_foot_max_mm}},
         {"patient_marker_rms_mm", retargeted.motion.overall_rms_mm()},
+        {"patient_marker_rms_aligned_mm", retargeted.aligned_marker_rms_mm},
         {"notes", retargeted.notes}};
     context.info("retargeted: leg length ratio " + std::to_string(retargeted.leg_length_ratio) +
                  ", patient markers vs trial RMS " +

@@ -24,8 +24,11 @@ bool is_foot(const std::string& body) {
   return body.starts_with("calcn") || body.starts_with("toes") || body.starts_with("foot");
 }
 
-// Per frame, the lowest (y) marker on a foot body; NaN without one.
-Eigen::VectorXd lowest_foot_marker(const Skeleton& skeleton, const Eigen::MatrixXd& coordinates) {
+// Per frame, the lowest (y) marker on a foot body that `other` also has
+// (so that a two-legged subject is compared with a one-legged patient on the
+// same foot); NaN without one.
+Eigen::VectorXd lowest_foot_marker(const Skeleton& skeleton, const Eigen::MatrixXd& coordinates,
+                                   const Skeleton& other) {
   Eigen::VectorXd lowest = Eigen::VectorXd::Constant(coordinates.rows(), std::nan(""));
   SkeletonPose pose(skeleton);
   for (Eigen::Index k = 0; k < coordinates.rows(); ++k) {
@@ -33,7 +36,8 @@ Eigen::VectorXd lowest_foot_marker(const Skeleton& skeleton, const Eigen::Matrix
     double low = std::numeric_limits<double>::infinity();
     for (std::size_t m = 0; m < skeleton.markers.size(); ++m) {
       const SkeletonMarker& marker = skeleton.markers[m];
-      if (!is_foot(skeleton.bodies[static_cast<std::size_t>(marker.body)].name)) continue;
+      const std::string& body = skeleton.bodies[static_cast<std::size_t>(marker.body)].name;
+      if (!is_foot(body) || !other.body_index(body)) continue;
       low = std::min(low, pose.marker(static_cast<int>(m)).y());
     }
     if (std::isfinite(low)) lowest(k) = low;
@@ -86,6 +90,7 @@ Retargeted retarget_motion(const FusedMotion& source, const Skeleton& source_ske
         "root translations copied unscaled");
   }
   const Eigen::Index frames = source.num_frames();
+  const std::optional<int> vertical = vertical_root_coordinate(target);
   Eigen::MatrixXd coordinates(frames, target.num_coordinates());
   for (int c = 0; c < target.num_coordinates(); ++c) {
     const SkeletonCoordinate& coordinate = target.coordinates[static_cast<std::size_t>(c)];
@@ -95,8 +100,14 @@ Retargeted retarget_motion(const FusedMotion& source, const Skeleton& source_ske
       result.defaulted.push_back(coordinate.name);
       continue;
     }
-    const double scale = coordinate.unit == CoordinateUnit::kLength ? result.leg_length_ratio : 1.0;
-    coordinates.col(c) = scale * source.coordinates.col(*from);
+    coordinates.col(c) = source.coordinates.col(*from);
+    if (coordinate.unit == CoordinateUnit::kLength) {
+      // Height in proportion to the legs; horizontal travel in proportion
+      // to the stride, from where the subject started.
+      const double start = c == vertical.value_or(-1) ? 0.0 : source.coordinates(0, *from);
+      coordinates.col(c).array() =
+          start + result.leg_length_ratio * (coordinates.col(c).array() - start);
+    }
     if (coordinate.clamped && coordinate.lower < coordinate.upper && !coordinate.locked) {
       coordinates.col(c) = coordinates.col(c).cwiseMax(coordinate.lower).cwiseMin(coordinate.upper);
     }
@@ -108,11 +119,11 @@ Retargeted retarget_motion(const FusedMotion& source, const Skeleton& source_ske
                             source_skeleton.name + "'; nothing would move it");
   }
 
-  const Eigen::VectorXd source_feet = lowest_foot_marker(source_skeleton, source.coordinates);
+  const Eigen::VectorXd source_feet =
+      lowest_foot_marker(source_skeleton, source.coordinates, target);
   result.source_foot_min_mm = source_feet.minCoeff();
   result.source_foot_max_mm = source_feet.maxCoeff();
-  Eigen::VectorXd target_feet = lowest_foot_marker(target, coordinates);
-  const std::optional<int> vertical = vertical_root_coordinate(target);
+  Eigen::VectorXd target_feet = lowest_foot_marker(target, coordinates, source_skeleton);
   if (options.keep_ground_contact && vertical && std::isfinite(target_feet.minCoeff()) &&
       std::isfinite(source_feet.minCoeff())) {
     result.vertical_shift_mm = source_feet.minCoeff() - target_feet.minCoeff();
@@ -142,6 +153,8 @@ Retargeted retarget_motion(const FusedMotion& source, const Skeleton& source_ske
   motion.iterations = Eigen::VectorXi::Zero(frames);
   motion.fit_seconds = Eigen::VectorXd::Zero(frames);
   ChainFitter evaluator(target, motion.setup);
+  double aligned_squares = 0.0;
+  int aligned_count = 0;
   motion.marker_errors.resize(frames, static_cast<Eigen::Index>(motion.setup.markers.size()));
   motion.rms_mm.resize(frames);
   motion.max_mm.resize(frames);
@@ -156,11 +169,36 @@ Retargeted retarget_motion(const FusedMotion& source, const Skeleton& source_ske
                                  .transpose();
     }
     const ChainFitResult at = evaluator.evaluate(targets, coordinates.row(k).transpose());
+    // The same without the frame's mean offset: how differently the
+    // patient's body is configured, whatever the stride scaling did to
+    // where it is.
+    Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+    int present = 0;
+    std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> pairs;
+    for (std::size_t i = 0; i < motion.setup.markers.size(); ++i) {
+      const Eigen::Vector3d measured = targets.row(static_cast<Eigen::Index>(i)).transpose();
+      if (!measured.allFinite()) continue;
+      const SkeletonMarker& marker =
+          target.markers[static_cast<std::size_t>(motion.setup.markers[i].model)];
+      const Eigen::Vector3d model =
+          motion.poses[static_cast<std::size_t>(k)][static_cast<std::size_t>(marker.body)] *
+          marker.local;
+      pairs.emplace_back(model, measured);
+      offset += model - measured;
+      ++present;
+    }
+    if (present > 0) offset /= present;
+    for (const auto& [model, measured] : pairs) {
+      aligned_squares += (model - offset - measured).squaredNorm();
+      ++aligned_count;
+    }
     motion.marker_errors.row(k) = at.marker_errors.transpose();
     motion.rms_mm(k) = at.rms_mm;
     motion.max_mm(k) = at.max_mm;
     motion.markers_used(k) = at.markers_used;
   }
+  result.aligned_marker_rms_mm =
+      aligned_count > 0 ? std::sqrt(aligned_squares / aligned_count) : std::nan("");
   return result;
 }
 

@@ -3,10 +3,11 @@
 // different patient. Joint angles transfer by coordinate name (they mean the
 // same on both: the atlas keeps OpenSim's joint definitions); the root's
 // translations scale with the ratio of leg lengths (hip to knee to ankle
-// centres), so the patient walks with the subject's stride in proportion
-// to its own size; then the patient is shifted vertically so that its
-// lowest foot marker touches the ground as low as the subject's did
-// (ground contact kept). The result is measured, not assumed: the
+// centres): its height in full, its horizontal travel from where the
+// subject started, so the patient walks with the subject's stride in
+// proportion to its own size; then the patient is shifted vertically so
+// that its lowest foot marker touches the ground as low as the subject's
+// did, on the same foot (ground contact kept). The result is measured, not assumed: the
 // patient's markers against the trial's, and the foot heights of both, for
 // a person to judge.
 //
@@ -38,6 +39,9 @@ struct Retargeted {
   double source_foot_max_mm = 0.0;
   double target_foot_min_mm = 0.0;
   double target_foot_max_mm = 0.0;
+  // RMS of the patient's markers against the trial's after removing each
+  // frame's mean offset (mm): the difference in body configuration.
+  double aligned_marker_rms_mm = 0.0;
   std::vector<std::string> notes;
 };
 
