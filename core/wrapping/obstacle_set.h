@@ -1,0 +1,59 @@
+#pragma once
+// Obstacle-set wrapping (Garner & Pandy 2000, "The obstacle-set method for
+// representing muscle paths in musculoskeletal models"): the shortest path
+// of a muscle's action line from P to S that stays outside an analytic
+// obstacle, in closed form.
+//
+//   sphere   (centre c, radius r): the geodesic lies in the plane through
+//            c, P and S; straight to the tangent point T1, along the great
+//            circle to T2, straight to S. Length
+//              sqrt(|P-c|^2 - r^2) + r * theta + sqrt(|S-c|^2 - r^2)
+//   cylinder (axis z of its frame, radius r, infinite): unroll the surface.
+//            In the xy-plane the path is the 2D sphere case on the circle;
+//            z grows linearly with the unrolled length, so the wrapped part
+//            is a helix and the length is sqrt(L_xy^2 + (z_S - z_P)^2).
+//
+// The path wraps only when the straight segment P-S would pass through the
+// obstacle (for the cylinder: its xy-projection through the circle) and,
+// with a quadrant ("+x", "-y", ...: the side of the obstacle, in its frame,
+// the path may wrap on), only on that side: a straight line outside the
+// allowed side is left straight, a path that must wrap goes around it.
+// Points inside the obstacle have no wrapping path (reported, straight).
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+namespace mmm::wrapping {
+
+enum class ObstacleShape { kSphere, kCylinder };
+
+struct Obstacle {
+  ObstacleShape shape = ObstacleShape::kSphere;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // obstacle frame -> world (mm)
+  double radius = 0.0;                                     // mm, > 0
+  std::string quadrant = "all";  // "all", "+x", "-x", "+y", "-y" (cylinder: x or y only)
+};
+
+struct WrapResult {
+  bool wrapped = false;  // the path touches the obstacle
+  bool inside = false;   // P or S lies inside the obstacle: no wrapping path exists
+  Eigen::Vector3d tangent_in = Eigen::Vector3d::Zero();   // T1 (world, mm) when wrapped
+  Eigen::Vector3d tangent_out = Eigen::Vector3d::Zero();  // T2
+  double wrap_angle = 0.0;  // rad swept on the obstacle (in the xy-plane for a cylinder)
+  double length = 0.0;      // of the whole path P -> S (mm)
+  // The path as a polyline P, T1, points on the surface every
+  // `arc_step_mm` at most, T2, S (just P, S when not wrapped).
+  std::vector<Eigen::Vector3d> points;
+};
+
+struct WrapOptions {
+  double arc_step_mm = 2.0;  // resolution of the wrapped part of `points`
+};
+
+// Throws InvalidInputError for a non-positive radius, an unknown quadrant
+// or non-finite points.
+WrapResult wrap_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& s,
+                        const Obstacle& obstacle, const WrapOptions& options = {});
+
+}  // namespace mmm::wrapping
