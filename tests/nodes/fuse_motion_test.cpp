@@ -18,6 +18,7 @@
 #include "tests/nodes/node_harness.h"
 #include "tests/support/test_data.h"
 #include "tests/support/toy_leg_atlas.h"
+#include "workflow/definition/node_catalog.h"
 
 namespace mmm::nodes {
 namespace {
@@ -28,6 +29,157 @@ std::filesystem::path pipelines() { return mmm::test::data_dir() / "gait2392" / 
 
 workflow::ArtifactRef add_file(test::NodeHarness& harness, const std::filesystem::path& file) {
   return harness.add(PortType::kFile, mmm::test::read_text(file));
+}
+
+// Golden spec: a change of a port, a parameter or a default must show here.
+TEST(FuseMotionNodeTest, SpecIsPinned) {
+  EXPECT_EQ(workflow::node_spec_json(FuseMotion::spec()).dump(2), R"json({
+  "description": "Drive a model with a marker trial: Kabsch per body, Ceres kinematic-chain fit, Kalman filter with RTS smoother and joint limits; optional marker placement from a static trial and retargeting from the trial subject's model to the patient's atlas",
+  "inputs": [
+    {
+      "description": "Marker trial (.trc); gaps and NaN frames allowed",
+      "name": "trial",
+      "required": true,
+      "type": "File"
+    },
+    {
+      "description": "The patient's (scaled) atlas to drive",
+      "name": "atlas",
+      "required": false,
+      "type": "Atlas"
+    },
+    {
+      "description": "OpenSim model (.osim): driven itself, or with an atlas the trial subject's model the motion is fitted to and retargeted from",
+      "name": "model",
+      "required": false,
+      "type": "File"
+    },
+    {
+      "description": "Marker mapping (YAML, schemas/motion/); default: gait2392's with OpenSim's IK weights",
+      "name": "mapping",
+      "required": false,
+      "type": "File"
+    },
+    {
+      "description": "Standing trial (.trc): the fitted model's markers are placed where the subject wore them",
+      "name": "static_trial",
+      "required": false,
+      "type": "File"
+    },
+    {
+      "description": "Joint angles to compare with (.mot, e.g. OpenSim IK)",
+      "name": "reference",
+      "required": false,
+      "type": "File"
+    }
+  ],
+  "manual": false,
+  "name": "fuse_motion",
+  "outputs": [
+    {
+      "description": "Per-frame coordinates, body poses and marker errors",
+      "name": "motion",
+      "type": "BonePoses"
+    },
+    {
+      "description": "Joint angles (.mot; deg and m, OpenSim's conventions)",
+      "name": "angles",
+      "type": "File"
+    },
+    {
+      "description": "CSV of every landmark, attachment area, action-line point and marker per frame",
+      "name": "points",
+      "type": "File"
+    },
+    {
+      "description": "Markers, residuals, filter, retargeting, reference comparison",
+      "name": "report",
+      "type": "Report"
+    },
+    {
+      "description": "SVG of the joint angles over time",
+      "name": "plot",
+      "type": "File"
+    },
+    {
+      "description": "Folder bundle of a ParaView animation (.pvd + .vtp per frame)",
+      "name": "animation",
+      "type": "File"
+    }
+  ],
+  "params": [
+    {
+      "default": 0.0,
+      "description": "First time fused (s); 0: the trial's start",
+      "min": 0.0,
+      "name": "start_time",
+      "type": "number",
+      "unit": "s"
+    },
+    {
+      "default": -1.0,
+      "description": "Last time fused (s); negative: the trial's end",
+      "name": "end_time",
+      "type": "number",
+      "unit": "s"
+    },
+    {
+      "choices": [
+        "none",
+        "forward",
+        "smoother"
+      ],
+      "default": "smoother",
+      "description": "Temporal filter: none (per-frame IK as OpenSim), forward Kalman, or Kalman with a Rauch-Tung-Striebel smoother (no lag)",
+      "name": "filter",
+      "type": "enum"
+    },
+    {
+      "default": 30.0,
+      "description": "Filter process noise of angles (white acceleration, rad/s^2 per sqrt(Hz))",
+      "max": 1000000.0,
+      "min": 0.001,
+      "name": "angular_acceleration_sd",
+      "type": "number"
+    },
+    {
+      "default": 3000.0,
+      "description": "Filter process noise of translations (mm/s^2 per sqrt(Hz))",
+      "max": 100000000.0,
+      "min": 0.001,
+      "name": "linear_acceleration_sd",
+      "type": "number"
+    },
+    {
+      "default": 5.0,
+      "description": "Noise of a weight-1 marker, as the filter assumes it",
+      "max": 100.0,
+      "min": 0.01,
+      "name": "marker_noise_mm",
+      "type": "number",
+      "unit": "mm"
+    },
+    {
+      "default": true,
+      "description": "Keep clamped coordinates inside their ranges",
+      "name": "joint_limits",
+      "type": "bool"
+    },
+    {
+      "default": true,
+      "description": "Retargeting: shift the patient vertically so that its feet reach the ground as low as the subject's",
+      "name": "keep_ground_contact",
+      "type": "bool"
+    },
+    {
+      "default": "lod1",
+      "description": "Atlas mesh level drawn in the animation",
+      "name": "mesh_level",
+      "type": "string"
+    }
+  ],
+  "version": 1
+})json");
 }
 
 TEST(FuseMotionNodeTest, DrivesOpenSimsSubjectModelAsOpenSimDoes) {
