@@ -76,9 +76,9 @@ struct FusedMotion {
 };
 
 // Throws InvalidInputError (trial file named) when no frame lies in
-// [start_time, end_time], when the tracked markers of the root are never
-// all... present in >= 3 in any frame (nothing can place it), or from
-// bind_tracking; SolverError when a fit fails.
+// [start_time, end_time] or no frame has 3 of the root's tracked markers
+// (nothing can place it), and from bind_tracking; SolverError when a fit
+// fails.
 FusedMotion fuse_motion(const Skeleton& skeleton, const opensim::MarkerTrajectories& trial,
                         const MarkerMapping& mapping, const MotionFusionOptions& options = {});
 
