@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <optional>
 
@@ -110,6 +111,72 @@ Eigen::Vector3d direction_at(const std::vector<Eigen::Vector3d>& line, std::size
   return d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::UnitZ();
 }
 
+// The bones from `a` to `b` along the chain (both included; through their
+// nearest common ancestor). Without a chain, or when they are not
+// connected, just the two.
+std::vector<std::string> chain_between(const std::string& a, const std::string& b,
+                                       const std::map<std::string, std::string>& parent) {
+  const auto ancestors = [&](const std::string& bone) {
+    std::vector<std::string> line{bone};
+    for (auto it = parent.find(bone); it != parent.end() && line.size() < 64;
+         it = parent.find(it->second)) {
+      line.push_back(it->second);
+    }
+    return line;
+  };
+  const std::vector<std::string> up_a = ancestors(a);
+  const std::vector<std::string> up_b = ancestors(b);
+  for (std::size_t i = 0; i < up_a.size(); ++i) {
+    const auto common = std::find(up_b.begin(), up_b.end(), up_a[i]);
+    if (common == up_b.end()) continue;
+    std::vector<std::string> chain(up_a.begin(), up_a.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+    // Then down from the common ancestor to b.
+    chain.insert(chain.end(), std::make_reverse_iterator(common), up_b.rend());
+    return chain;
+  }
+  return {a, b};
+}
+
+// The bone a split point at `x` of segment a -> b rides on (see the header).
+std::string bone_along_chain(const PathPoint& a, const PathPoint& b, const Eigen::Vector3d& x,
+                             const ActionLineFitOptions& options,
+                             const std::function<double(const std::string&)>& squared_distance) {
+  const std::vector<std::string> chain = chain_between(a.bone, b.bone, options.parent_bone);
+  const Eigen::Vector3d along = b.position - a.position;
+  // Walking from a to b, each step crosses the joint of the deeper bone.
+  std::string chosen = chain.front();
+  bool by_joints = true;
+  for (std::size_t i = 0; i + 1 < chain.size() && by_joints; ++i) {
+    const auto parent = options.parent_bone.find(chain[i]);
+    const std::string& child = parent != options.parent_bone.end() && parent->second == chain[i + 1]
+                                   ? chain[i]
+                                   : chain[i + 1];
+    const auto centre = options.joint_centre.find(child);
+    if (centre == options.joint_centre.end()) {
+      by_joints = false;
+      break;
+    }
+    if ((x - centre->second).dot(along) > 0) chosen = chain[i + 1];
+  }
+  if (by_joints) return chosen;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const std::string& bone : chain) {
+    // The segment's own bones must have trees (squared_distance names a
+    // missing one); bones in between without one are passed over.
+    double distance = std::numeric_limits<double>::infinity();
+    try {
+      distance = squared_distance(bone);
+    } catch (const InvalidInputError&) {
+      if (bone == a.bone || bone == b.bone) throw;
+    }
+    if (distance < nearest) {
+      nearest = distance;
+      chosen = bone;
+    }
+  }
+  return chosen;
+}
+
 }  // namespace
 
 std::vector<ActionLineFitReport> fit_action_lines(
@@ -200,11 +267,9 @@ std::vector<ActionLineFitReport> fit_action_lines(
                   bundle, middle, (b.position - a.position).normalized(), geometry, options)) {
             PathPoint added;
             added.name = line.name + "-fit" + std::to_string(report.points_added + 1);
-            const double to_a =
-                std::sqrt(bone_tree(a.bone).closest_point(*centre).squared_distance);
-            const double to_b =
-                std::sqrt(bone_tree(b.bone).closest_point(*centre).squared_distance);
-            added.bone = to_a <= to_b ? a.bone : b.bone;
+            added.bone = bone_along_chain(a, b, *centre, options, [&](const std::string& bone) {
+              return bone_tree(bone).closest_point(*centre).squared_distance;
+            });
             added.position = *centre;
             refined.push_back(std::move(added));
             ++report.points_added;

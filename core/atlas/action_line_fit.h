@@ -19,8 +19,13 @@
 //      whose place is a function of a coordinate, stay);
 //   4. a segment that still leaves the muscle is split at its middle by a
 //      new fixed via point at the cross-section centre there, attached to
-//      whichever of the segment's bones is nearer; recursively, up to
-//      `max_splits` levels.
+//      the bone of the kinematic chain between the segment's two bones that
+//      it lies along: past a joint on the chain (its centre projected on
+//      the segment's direction), the bone beyond it (a hamstring's
+//      pelvis-to-tibia segment passes the femur: a point at mid-thigh rides
+//      on the femur, not on the pelvis, or hip flexion would drag it
+//      along). Without joint centres, the nearest of those bones' surfaces.
+//      Recursively, up to `max_splits` levels.
 
 #include <functional>
 #include <map>
@@ -41,6 +46,11 @@ struct ActionLineFitOptions {
   double sample_step_mm = 1.0;  // for the inside fraction of a segment
   double good_fraction = 0.95;  // segments at least this much inside are not split
   double min_segment_mm = 8.0;  // shorter segments are not split
+  // The kinematic chain, bone -> parent bone (every joint's child -> parent),
+  // and the centre of each bone's joint with its parent (rest pose, mm).
+  // Empty: a split point attaches to one of its segment's two bones.
+  std::map<std::string, std::string> parent_bone;
+  std::map<std::string, Eigen::Vector3d> joint_centre;
 };
 
 struct ActionLineFitReport {

@@ -582,6 +582,13 @@ void Builder::clean_and_attach() {
   // One signed distance per bone; its tree serves the closest-point queries.
   std::map<std::string, std::unique_ptr<mesh::SignedDistance>> distances;
   std::map<std::string, const mesh::AabbTree*> trees;
+  // Split points of the action lines may ride on any bone their segment
+  // passes along the chain (the femur for a hamstring's pelvis-tibia span).
+  ActionLineFitOptions fit_options;
+  for (const Joint& joint : atlas_.joints) {
+    fit_options.parent_bone[joint.child] = joint.parent;
+    fit_options.joint_centre[joint.child] = joint.child_frame.translation();
+  }
   for (const auto& [name, surface] : bone_meshes_) {
     if (surface.F.rows() == 0) {
       throw InvalidInputError("atlas build: bone " + name + " has an empty surface");
@@ -618,7 +625,7 @@ void Builder::clean_and_attach() {
     const mesh::WindingNumber winding(muscle_tree);
     for (const ActionLineFitReport& fitted : fit_action_lines(
              muscle, muscle_tree, [&](const Eigen::Vector3d& q) { return winding.is_inside(q); },
-             trees)) {
+             trees, fit_options)) {
       report_.action_lines.push_back({muscle.name, fitted.line, fitted.inside_before,
                                       fitted.inside_after, fitted.points_added,
                                       fitted.origin_on_contact, fitted.insertion_on_contact});

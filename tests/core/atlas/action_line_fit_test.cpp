@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -237,6 +238,58 @@ TEST(ActionLineFitTest, ArchedMuscleGetsViaPointsAlongItsCurve) {
     }
   }
   EXPECT_EQ(added, report.points_added);
+}
+
+TEST(ActionLineFitTest, SplitPointsRideOnTheNearestBoneAlongTheChain) {
+  // The arch spans two bones through a third one at its apex (as a
+  // hamstring spans pelvis -> femur -> tibia): points near the apex belong
+  // to the middle bone, not to either end's.
+  Scene scene(arch_tube());
+  scene.add_bone("right_foot", Eigen::Vector3d(30, -20, -20), Eigen::Vector3d(70, 20, 0));
+  scene.add_bone("left_foot", Eigen::Vector3d(-70, -20, -20), Eigen::Vector3d(-30, 20, 0));
+  const double top = kArchRadius + kTubeRadius + 2.0;
+  scene.add_bone("keystone", Eigen::Vector3d(-15, -20, top), Eigen::Vector3d(15, 20, top + 10));
+  Muscle muscle;
+  muscle.name = "arch";
+  ActionLine line;
+  line.name = "arch_line";
+  line.points = {point("origin", "right_foot", {60, 0, -5}), point("via", "right_foot", {0, 0, 20}),
+                 point("insertion", "left_foot", {-60, 0, -5})};
+  muscle.action_lines = {line};
+  ActionLineFitOptions options;
+  options.parent_bone = {{"right_foot", "keystone"}, {"left_foot", "keystone"}};
+  const auto reports = fit_action_lines(muscle, scene.tree, scene.inside, scene.bones, options);
+  ASSERT_GT(reports.front().points_added, 0);
+  int on_keystone = 0;
+  for (const PathPoint& p : muscle.action_lines.front().points) {
+    if (!p.name.starts_with("arch_line-fit")) continue;
+    // Each on the nearest of the three.
+    std::string nearest;
+    double best = std::numeric_limits<double>::infinity();
+    for (const char* bone : {"right_foot", "left_foot", "keystone"}) {
+      const double d = scene.bones.at(bone)->closest_point(p.position).squared_distance;
+      if (d < best) {
+        best = d;
+        nearest = bone;
+      }
+    }
+    EXPECT_EQ(p.bone, nearest) << p.name;
+    on_keystone += p.bone == "keystone" ? 1 : 0;
+  }
+  EXPECT_GT(on_keystone, 0);
+
+  // With the joints' centres, a point belongs to the bone past whose joint
+  // it lies along the segment: right of x = 20 the right foot, left of
+  // x = -20 the left one, the keystone between.
+  muscle.action_lines = {line};
+  options.joint_centre = {{"right_foot", Eigen::Vector3d(20, 0, 60)},
+                          {"left_foot", Eigen::Vector3d(-20, 0, 60)}};
+  fit_action_lines(muscle, scene.tree, scene.inside, scene.bones, options);
+  for (const PathPoint& p : muscle.action_lines.front().points) {
+    if (!p.name.starts_with("arch_line-fit")) continue;
+    const double x = p.position.x();
+    EXPECT_EQ(p.bone, x > 20 ? "right_foot" : (x < -20 ? "left_foot" : "keystone")) << p.name;
+  }
 }
 
 TEST(ActionLineFitTest, MovingPointsStay) {
