@@ -1,12 +1,12 @@
 #include "nodes/registry.h"
 
 #include "nodes/decimate_mesh.h"
+#include "nodes/fuse_motion.h"
 #include "nodes/import_markups.h"
 #include "nodes/landmark_report.h"
 #include "nodes/load_mesh.h"
 #include "nodes/load_radiographs.h"
 #include "nodes/measure_mesh.h"
-#include "nodes/fuse_motion.h"
 #include "nodes/scale_atlas.h"
 #include "nodes/static_trial_landmarks.h"
 #include "worklists/landmark_task.h"
