@@ -107,7 +107,8 @@ nlohmann::json fit_summary(const motion::FusedMotion& fused) {
 // The bundle of the animation: bones of the atlas at `level`, the stick
 // figure, the action lines, per frame.
 std::string animation_bundle(const workflow::NodeContext& context, const motion::Skeleton& skeleton,
-                             const motion::FusedMotion& fused, const atlas::Atlas* atlas,
+                             const motion::FusedMotion& fused,
+                             const motion::PointTrajectories& points, const atlas::Atlas* atlas,
                              const std::filesystem::path& atlas_dir, const std::string& level) {
   const std::filesystem::path folder = context.scratch_dir() / "animation";
   std::filesystem::remove_all(folder);
@@ -123,8 +124,6 @@ std::string animation_bundle(const workflow::NodeContext& context, const motion:
                          mesh::read_mesh(atlas_dir / chosen->file));
     }
   }
-  std::optional<motion::PointTrajectories> points;
-  if (atlas != nullptr) points = motion::atlas_point_trajectories(*atlas, skeleton, fused);
   for (Eigen::Index k = 0; k < fused.num_frames(); ++k) {
     const double t = fused.times(k);
     const auto frame = static_cast<int>(k);
@@ -144,7 +143,7 @@ std::string animation_bundle(const workflow::NodeContext& context, const motion:
       for (const auto& [a, b] : stick.segments) lines.lines.push_back({a, b});
       series.add_polylines(t, frame, "skeleton", lines);
     }
-    if (points) {
+    {  // action lines exist only for an atlas; markers have no path points
       // Action lines: the active points of each line, in order.
       mesh::Polylines lines;
       std::vector<Eigen::Vector3d> xyz;
@@ -154,17 +153,17 @@ std::string animation_bundle(const workflow::NodeContext& context, const motion:
         if (line.size() >= 2) lines.lines.push_back(line);
         line.clear();
       };
-      for (std::size_t i = 0; i < points->points.size(); ++i) {
-        const motion::TrackedPoint& p = points->points[i];
+      for (std::size_t i = 0; i < points.points.size(); ++i) {
+        const motion::TrackedPoint& p = points.points[i];
         if (p.kind != "path_point") continue;
         if (p.element != current) {
           flush();
           current = p.element;
         }
-        if (points->active(k, static_cast<Eigen::Index>(i)) == 0) continue;
+        if (points.active(k, static_cast<Eigen::Index>(i)) == 0) continue;
         line.push_back(static_cast<int>(xyz.size()));
         xyz.emplace_back(
-            points->positions.block<1, 3>(k, 3 * static_cast<Eigen::Index>(i)).transpose());
+            points.positions.block<1, 3>(k, 3 * static_cast<Eigen::Index>(i)).transpose());
       }
       flush();
       if (!lines.lines.empty()) {
@@ -359,9 +358,9 @@ void FuseMotion::run(workflow::NodeContext& context) {
   plot_options.title = "Joint angles: " + target_name + (reference ? " vs reference" : "");
   context.set_output("plot",
                      motion::joint_angle_svg(fit, reference ? &*reference : nullptr, plot_options));
-  context.set_output("animation",
-                     animation_bundle(context, target, result, patient ? &*patient : nullptr,
-                                      atlas_dir, context.text("mesh_level")));
+  context.set_output(
+      "animation", animation_bundle(context, target, result, points, patient ? &*patient : nullptr,
+                                    atlas_dir, context.text("mesh_level")));
   report["seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   context.set_output("report", report.dump(2));
