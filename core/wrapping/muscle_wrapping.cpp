@@ -1,0 +1,387 @@
+#include "core/wrapping/muscle_wrapping.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "core/errors.h"
+#include "core/mesh/decimate.h"
+#include "core/mesh/io/mesh_io.h"
+#include "core/mesh/laplacian.h"
+#include "core/motion/skeleton.h"
+
+namespace mmm::wrapping {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Eigen::Isometry3d;
+using Eigen::MatrixX3d;
+using Eigen::VectorXd;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+const atlas::MeshLevel& full_level(const std::vector<atlas::MeshLevel>& levels,
+                                   const std::string& element) {
+  for (const atlas::MeshLevel& level : levels) {
+    if (level.level == "full") return level;
+  }
+  if (levels.empty()) throw InvalidInputError("muscle wrapping: '" + element + "' has no mesh");
+  return levels.front();
+}
+
+// Every skeleton coordinate at its atlas rest value.
+VectorXd rest_coordinates(const atlas::Atlas& atlas, const motion::Skeleton& skeleton) {
+  VectorXd q = skeleton.default_coordinates();
+  for (const atlas::Joint& joint : atlas.joints) {
+    for (const atlas::Coordinate& coordinate : joint.coordinates) {
+      if (const auto index = skeleton.coordinate_index(coordinate.name))
+        q[*index] = coordinate.rest_value;
+    }
+  }
+  return q;
+}
+
+// The motion's frames as coordinate vectors of `skeleton` (by name).
+std::vector<VectorXd> frame_coordinates(const motion::FusedMotion& motion,
+                                        const motion::Skeleton& skeleton, const VectorXd& rest) {
+  std::vector<std::pair<int, int>> columns;  // skeleton index, motion column
+  for (int c = 0; c < skeleton.num_coordinates(); ++c) {
+    if (const auto column =
+            motion.coordinate_index(skeleton.coordinates[static_cast<std::size_t>(c)].name)) {
+      columns.emplace_back(c, *column);
+    }
+  }
+  if (columns.empty()) {
+    throw InvalidInputError(
+        "muscle wrapping: the motion has none of the atlas skeleton's coordinates; hint: fuse the "
+        "motion on this atlas (fuse_motion with the atlas input)");
+  }
+  std::vector<VectorXd> frames;
+  for (Eigen::Index f = 0; f < motion.num_frames(); ++f) {
+    VectorXd q = rest;
+    for (const auto& [index, column] : columns) q[index] = motion.coordinates(f, column);
+    frames.push_back(std::move(q));
+  }
+  return frames;
+}
+
+struct PosedBones {
+  std::vector<std::string> names;
+  std::vector<int> bodies;  // skeleton body per bone
+  std::vector<PosableBone> surfaces;
+  std::map<std::string, int> index;
+};
+
+PosedBones load_bones(const atlas::Atlas& atlas, const std::filesystem::path& dir,
+                      const motion::Skeleton& skeleton) {
+  PosedBones bones;
+  for (const atlas::Bone& bone : atlas.bones) {
+    const auto body = skeleton.body_index(bone.name);
+    if (!body || bone.meshes.empty()) continue;
+    const mesh::IndexedMesh surface =
+        mesh::read_mesh(dir / full_level(bone.meshes, bone.name).file);
+    bones.index[bone.name] = static_cast<int>(bones.names.size());
+    bones.names.push_back(bone.name);
+    bones.bodies.push_back(*body);
+    bones.surfaces.push_back({bone.name, std::make_shared<const mesh::SignedDistance>(surface)});
+  }
+  return bones;
+}
+
+std::vector<Isometry3d> bone_poses(const motion::SkeletonPose& pose, const PosedBones& bones) {
+  std::vector<Isometry3d> poses;
+  poses.reserve(bones.bodies.size());
+  for (const int body : bones.bodies) poses.push_back(pose.body_pose(body));
+  return poses;
+}
+
+int bone_index(const PosedBones& bones, const std::string& bone, const std::string& what) {
+  const auto found = bones.index.find(bone);
+  if (found == bones.index.end()) {
+    throw InvalidInputError("muscle wrapping: " + what + " is on bone '" + bone +
+                            "', which has no mesh or is not in the skeleton");
+  }
+  return found->second;
+}
+
+double bending(const Eigen::SparseMatrix<double>& laplacian, const MatrixX3d& x) {
+  return (laplacian * x).squaredNorm();
+}
+
+// Contacts of the previous solve carried to new bone poses.
+std::vector<Contact> carried(const std::vector<Contact>& contacts,
+                             const std::vector<Isometry3d>& from,
+                             const std::vector<Isometry3d>& to) {
+  std::vector<Contact> result;
+  result.reserve(contacts.size());
+  for (Contact contact : contacts) {
+    if (contact.obstacle >= 0) {
+      const auto b = static_cast<std::size_t>(contact.obstacle);
+      contact.target = to[b] * (from[b].inverse() * contact.target);
+    }
+    result.push_back(contact);
+  }
+  return result;
+}
+
+class MuscleWrapper {
+ public:
+  MuscleWrapper(const atlas::Atlas& atlas, const atlas::Muscle& muscle,
+                const std::filesystem::path& dir, const motion::Skeleton& skeleton,
+                const PosedBones& bones, const VectorXd& rest_q,
+                const MuscleWrappingOptions& options)
+      : atlas_(atlas), muscle_(muscle), skeleton_(skeleton), bones_(bones), options_(options) {
+    const Clock::time_point start = Clock::now();
+    if (muscle.action_lines.empty()) {
+      throw InvalidInputError("muscle wrapping: muscle '" + muscle.name + "' has no action line");
+    }
+    result_.name = muscle.name;
+    mesh::IndexedMesh surface = mesh::read_mesh(dir / full_level(muscle.meshes, muscle.name).file);
+    if (options.target_faces > 0 && surface.F.rows() > options.target_faces) {
+      mesh::DecimateOptions decimate;
+      decimate.target_faces = options.target_faces;
+      surface = mesh::decimate(surface, decimate);
+    }
+    result_.rest = surface;
+    laplacian_ = mesh::cotangent_laplacian(surface.V, surface.F);
+    rest_bending_ = bending(laplacian_, surface.V);
+
+    motion::SkeletonPose pose(skeleton);
+    pose.set(rest_q);
+    rest_poses_ = bone_poses(pose, bones);
+    // The skeleton at rest is the atlas moved rigidly (every bone by the
+    // root's rest pose, skeleton_from_atlas): the rest paths go back to the
+    // atlas frame, where the surface is.
+    std::vector<LinePath> rest_lines = lines_at(pose, rest_q, -1);
+    const Isometry3d to_atlas = rest_poses_.front().inverse();
+    for (const Isometry3d& bone_pose : rest_poses_) {
+      if (!(bone_pose.matrix() - rest_poses_.front().matrix()).isZero(1e-6)) {
+        throw InvalidInputError(
+            "muscle wrapping: the atlas skeleton at rest does not keep every bone where the "
+            "atlas has it (bone '" +
+            bones.names[static_cast<std::size_t>(&bone_pose - rest_poses_.data())] +
+            "'); hint: check the atlas's joints (mmm atlas check)");
+      }
+    }
+    for (LinePath& line : rest_lines) {
+      for (Eigen::Vector3d& point : line.points) point = to_atlas * point;
+    }
+    for (const atlas::ActionLine& line : muscle.action_lines)
+      result_.lines.push_back({line.name, {}, {}, {}});
+
+    contacts_ = std::make_unique<BoneContacts>(surface.V, bones.surfaces, options.contacts);
+    std::set<int> attachment_bones;
+    for (const auto* areas : {&muscle.origins, &muscle.insertions}) {
+      for (const atlas::AttachmentArea& area : *areas) {
+        if (const auto found = bones.index.find(area.bone); found != bones.index.end()) {
+          attachment_bones.insert(found->second);
+        }
+      }
+    }
+    for (const LinePath& line : rest_lines) {
+      attachment_bones.insert(line.origin_pose_index);
+      attachment_bones.insert(line.insertion_pose_index);
+    }
+    std::vector<AttachmentBone> attachments;
+    for (const int b : attachment_bones) {
+      attachments.push_back(
+          {b, contacts_->rest_distance(static_cast<std::size_t>(b)).cwiseMax(0.0)});
+    }
+    binding_ = std::make_unique<MuscleBinding>(surface.V, rest_lines, std::move(attachments),
+                                               options.binding);
+    deformer_ = std::make_unique<VolumeDeformer>(surface, options.deformer);
+    result_.rest_volume_mm3 = deformer_->rest_volume();
+    result_.rest_penetration = contacts_->measure(
+        surface.V, std::vector<Isometry3d>(bones.names.size(), Isometry3d::Identity()));
+    previous_q_ = rest_q;
+    previous_poses_ = rest_poses_;
+    result_.setup_seconds = seconds_since(start);
+  }
+
+  void frame(const VectorXd& q) {
+    const Clock::time_point start = Clock::now();
+    motion::SkeletonPose pose(skeleton_);
+    const int frame_index = static_cast<int>(result_.frames.size());
+    std::vector<Contact> contacts = contacts_carried_;
+    DeformResult solved;
+    std::vector<Isometry3d> poses;
+    const int stages = options_.intermediate_poses + 1;
+    for (int stage = 1; stage <= stages; ++stage) {
+      const double t = static_cast<double>(stage) / stages;
+      const VectorXd q_stage = (1.0 - t) * previous_q_ + t * q;
+      pose.set(q_stage);
+      poses = bone_poses(pose, bones_);
+      const std::vector<LinePath> lines =
+          lines_at(pose, q_stage, stage == stages ? frame_index : -1);
+      const MuscleBinding::Targets targets = binding_->targets(lines, poses);
+      contacts = carried(contacts, previous_poses_, poses);
+      ContactQuery query;
+      if (options_.bone_contacts) {
+        query = [&](const MatrixX3d& x, const std::vector<char>& active) {
+          return contacts_->find(x, poses, active);
+        };
+      } else {
+        contacts.clear();
+      }
+      solved = deformer_->solve(targets.positions, targets.rotations, contacts, query);
+      contacts = solved.contacts;
+      previous_poses_ = poses;
+    }
+    contacts_carried_ = contacts;
+    previous_q_ = q;
+
+    MuscleFrameMetrics metrics;
+    metrics.volume_error_percent = 100.0 * solved.volume_error;
+    const PenetrationMetrics penetration = contacts_->measure(solved.x, poses);
+    metrics.max_depth_mm = penetration.max_depth_mm;
+    metrics.vertices_inside = penetration.vertices_inside;
+    metrics.vertices_deeper = penetration.vertices_deeper;
+    metrics.deepest_bone = penetration.deepest_bone;
+    metrics.smoothness_change_percent =
+        100.0 * (bending(laplacian_, solved.x) / rest_bending_ - 1.0);
+    metrics.contacts = static_cast<int>(solved.contacts.size());
+    metrics.contact_rounds = solved.contact_rounds;
+    metrics.volume_iterations = solved.volume_iterations;
+    metrics.converged = solved.converged;
+    result_.positions.push_back(solved.x.cast<float>());
+    metrics.seconds = seconds_since(start);
+    result_.frames.push_back(metrics);
+  }
+
+  WrappedMuscle take() { return std::move(result_); }
+
+ private:
+  // The action lines in the pose; with frame >= 0 their paths, lengths and
+  // moment arms are recorded for that frame.
+  std::vector<LinePath> lines_at(const motion::SkeletonPose& pose, const VectorXd& q, int frame) {
+    std::vector<LinePath> lines;
+    for (std::size_t l = 0; l < muscle_.action_lines.size(); ++l) {
+      const atlas::ActionLine& line = muscle_.action_lines[l];
+      const ActionLinePath path =
+          action_line_path(atlas_, muscle_, line, skeleton_, q, options_.path);
+      LinePath posed;
+      posed.points = path.points;
+      posed.origin_pose_index =
+          bone_index(bones_, line.points.front().bone, "the origin of " + line.name);
+      posed.insertion_pose_index =
+          bone_index(bones_, line.points.back().bone, "the insertion of " + line.name);
+      lines.push_back(std::move(posed));
+      if (frame < 0) continue;
+      WrappedLine& record = result_.lines[l];
+      record.paths.push_back(path.points);
+      record.lengths_mm.push_back(path.length);
+      const auto arms = static_cast<Eigen::Index>(options_.moment_arm_coordinates.size());
+      record.moment_arms_mm.conservativeResize(frame + 1, arms);
+      for (Eigen::Index c = 0; c < arms; ++c) {
+        const auto coordinate = skeleton_.coordinate_index(
+            options_.moment_arm_coordinates[static_cast<std::size_t>(c)]);
+        record.moment_arms_mm(frame, c) =
+            coordinate ? moment_arm(atlas_, muscle_, line, skeleton_, q, *coordinate, options_.path)
+                       : std::numeric_limits<double>::quiet_NaN();
+      }
+    }
+    static_cast<void>(pose);
+    return lines;
+  }
+
+  const atlas::Atlas& atlas_;
+  const atlas::Muscle& muscle_;
+  const motion::Skeleton& skeleton_;
+  const PosedBones& bones_;
+  const MuscleWrappingOptions& options_;
+  WrappedMuscle result_;
+  Eigen::SparseMatrix<double> laplacian_;
+  double rest_bending_ = 1.0;
+  std::vector<Isometry3d> rest_poses_;
+  std::vector<Isometry3d> previous_poses_;
+  VectorXd previous_q_;
+  std::vector<Contact> contacts_carried_;
+  std::unique_ptr<BoneContacts> contacts_;
+  std::unique_ptr<MuscleBinding> binding_;
+  std::unique_ptr<VolumeDeformer> deformer_;
+};
+
+std::vector<const atlas::Muscle*> selected_muscles(const atlas::Atlas& atlas,
+                                                   const std::vector<std::string>& names) {
+  std::vector<const atlas::Muscle*> muscles;
+  if (names.empty()) {
+    for (const atlas::Muscle& muscle : atlas.muscles) muscles.push_back(&muscle);
+    return muscles;
+  }
+  for (const std::string& name : names) {
+    const atlas::Muscle* muscle = atlas.find_muscle(name);
+    if (muscle == nullptr)
+      throw InvalidInputError("muscle wrapping: the atlas has no muscle '" + name + "'");
+    muscles.push_back(muscle);
+  }
+  return muscles;
+}
+
+}  // namespace
+
+MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::path& atlas_dir,
+                            const motion::FusedMotion& motion,
+                            const MuscleWrappingOptions& options) {
+  const Clock::time_point start = Clock::now();
+  if (motion.num_frames() == 0) throw InvalidInputError("muscle wrapping: the motion has no frame");
+  if (options.intermediate_poses < 0)
+    throw InvalidInputError("muscle wrapping: intermediate_poses must be >= 0");
+  const std::vector<const atlas::Muscle*> muscles = selected_muscles(atlas, options.muscles);
+  const motion::Skeleton skeleton = motion::skeleton_from_atlas(atlas);
+  const VectorXd rest_q = rest_coordinates(atlas, skeleton);
+  const std::vector<VectorXd> frames = frame_coordinates(motion, skeleton, rest_q);
+  const PosedBones bones = load_bones(atlas, atlas_dir, skeleton);
+
+  MuscleWrapping result;
+  result.times = motion.times;
+  result.bone_names = bones.names;
+  result.moment_arm_coordinates = options.moment_arm_coordinates;
+  motion::SkeletonPose pose(skeleton);
+  for (const VectorXd& q : frames) {
+    pose.set(q);
+    result.bone_poses.push_back(bone_poses(pose, bones));
+  }
+
+  const int hardware = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  const int threads = std::clamp(options.threads > 0 ? options.threads : hardware, 1,
+                                 static_cast<int>(std::max<std::size_t>(1, muscles.size())));
+  result.threads = threads;
+  result.muscles.resize(muscles.size());
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto work = [&] {
+    for (std::size_t m = next++; m < muscles.size(); m = next++) {
+      try {
+        MuscleWrapper wrapper(atlas, *muscles[m], atlas_dir, skeleton, bones, rest_q, options);
+        for (const VectorXd& q : frames) wrapper.frame(q);
+        result.muscles[m] = wrapper.take();
+      } catch (...) {
+        const std::lock_guard lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+        next = muscles.size();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& thread : pool) thread.join();
+  if (failure) std::rethrow_exception(failure);
+  result.seconds = seconds_since(start);
+  return result;
+}
+
+}  // namespace mmm::wrapping

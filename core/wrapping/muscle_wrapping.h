@@ -1,0 +1,99 @@
+#pragma once
+// Muscle wrapping over a fused motion, energy-minimisation pathway: per
+// frame, every muscle's action lines are re-routed on the moving skeleton
+// (action_line_path.h) and its surface is deformed around them keeping its
+// volume and staying out of the bones (muscle_binding.h, volume_deformer.h,
+// bone_contacts.h).
+//
+// Per muscle, once: the surface at the wrapping resolution (the full mesh
+// decimated to `target_faces`), the binding to its rest action lines and
+// attachment bones, the factored energy, the rest distances to the bones.
+// Per frame, in order: the skeleton at the frame's coordinates, the line
+// paths and moment arms, the targets, the volume-constrained solve with the
+// contacts found inside it. Contacts of the previous frame start the next
+// one, carried by their bones; `intermediate_poses` > 0 solves at that many
+// coordinate vectors between the previous frame (the rest pose before the
+// first) and this one first (the interpolated variant, for large motions:
+// a vertex is pushed out of a bone on the side it entered). Muscles are
+// independent and run on `threads` threads.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/atlas/atlas.h"
+#include "core/mesh/mesh.h"
+#include "core/motion/motion_fusion.h"
+#include "core/wrapping/action_line_path.h"
+#include "core/wrapping/bone_contacts.h"
+#include "core/wrapping/muscle_binding.h"
+#include "core/wrapping/volume_deformer.h"
+
+namespace mmm::wrapping {
+
+struct MuscleWrappingOptions {
+  Eigen::Index target_faces = 10000;  // wrapping resolution; 0: the full mesh
+  bool bone_contacts = true;          // impenetrability with the bones
+  int intermediate_poses = 0;         // >= 0
+  std::vector<std::string> muscles;   // empty: every muscle of the atlas
+  std::vector<std::string> moment_arm_coordinates = {"hip_flexion_r", "hip_adduction_r",
+                                                     "hip_rotation_r", "knee_angle_r"};
+  int threads = 0;  // 0: the hardware's
+  DeformerOptions deformer;
+  BindingOptions binding;
+  ContactOptions contacts;
+  PathOptions path;
+};
+
+struct MuscleFrameMetrics {
+  double volume_error_percent = 0.0;
+  double max_depth_mm = 0.0;  // into any bone
+  int vertices_inside = 0;    // inside a bone at any depth
+  int vertices_deeper = 0;    // deeper than the contact tolerance
+  std::string deepest_bone;
+  double smoothness_change_percent = 0.0;  // bending energy sum |L x|^2 vs rest
+  int contacts = 0;
+  int contact_rounds = 0;
+  int volume_iterations = 0;
+  bool converged = true;
+  double seconds = 0.0;  // wall time of this muscle-frame (paths, targets, solve)
+};
+
+struct WrappedLine {
+  std::string name;
+  std::vector<std::vector<Eigen::Vector3d>> paths;  // per frame (mm)
+  std::vector<double> lengths_mm;                   // per frame
+  Eigen::MatrixXd moment_arms_mm;  // frames by moment-arm coordinates (NaN: absent)
+};
+
+struct WrappedMuscle {
+  std::string name;
+  mesh::IndexedMesh rest;                   // at the wrapping resolution (atlas frame)
+  std::vector<Eigen::MatrixX3f> positions;  // per frame (mm)
+  std::vector<MuscleFrameMetrics> frames;
+  std::vector<WrappedLine> lines;
+  double setup_seconds = 0.0;  // decimation, binding, factorisation, rest distances
+  double rest_volume_mm3 = 0.0;
+  PenetrationMetrics rest_penetration;  // of the rest surface in the rest pose
+};
+
+struct MuscleWrapping {
+  std::vector<WrappedMuscle> muscles;  // in atlas order
+  std::vector<std::string> moment_arm_coordinates;
+  Eigen::VectorXd times;                                   // s, per frame
+  std::vector<std::string> bone_names;                     // posed bones, as in bone_poses
+  std::vector<std::vector<Eigen::Isometry3d>> bone_poses;  // [frame][bone], rest -> frame
+  double seconds = 0.0;                                    // wall time of the whole wrapping
+  int threads = 1;
+};
+
+// atlas + its folder (meshes), a motion fused on a skeleton of this atlas
+// (its coordinates are matched by name; missing ones keep their rest value).
+// Throws InvalidInputError for an unknown muscle, a muscle without action
+// lines, a motion without frames or none of the atlas's coordinates.
+MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::path& atlas_dir,
+                            const motion::FusedMotion& motion,
+                            const MuscleWrappingOptions& options = {});
+
+}  // namespace mmm::wrapping
