@@ -27,8 +27,8 @@ struct PosableBone {
 };
 
 struct ContactOptions {
-  double tolerance_mm = 0.5;  // a vertex deeper than this becomes a contact
-  double clearance_mm = 0.2;  // contacts are pinned this far outside the surface
+  double tolerance_mm = 0.1;  // a vertex deeper than this becomes a contact
+  double clearance_mm = 0.0;  // contacts are pinned this far outside the surface
 };
 
 struct PenetrationMetrics {

@@ -6,6 +6,8 @@
 #include <string>
 #include <utility>
 
+#include <Eigen/SparseCore>
+
 #include "core/errors.h"
 
 namespace mmm::wrapping {
@@ -79,6 +81,31 @@ void check_line(const LinePath& line, std::size_t index) {
   }
 }
 
+// Half the vertex, half the mean of its neighbours (rows sum to 1).
+Eigen::SparseMatrix<double> neighbour_average(const Eigen::MatrixX3i& faces, Eigen::Index n) {
+  std::vector<Eigen::Triplet<double>> edges;
+  edges.reserve(static_cast<std::size_t>(6 * faces.rows()));
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    for (int corner = 0; corner < 3; ++corner) {
+      edges.emplace_back(faces(f, corner), faces(f, (corner + 1) % 3), 1.0);
+      edges.emplace_back(faces(f, (corner + 1) % 3), faces(f, corner), 1.0);
+    }
+  }
+  Eigen::SparseMatrix<double> adjacency(n, n);
+  adjacency.setFromTriplets(edges.begin(), edges.end(), [](double, double) { return 1.0; });
+  Eigen::SparseMatrix<double> averaging(n, n);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double degree = adjacency.col(i).sum();
+    entries.emplace_back(i, i, degree > 0 ? 0.5 : 1.0);
+    for (Eigen::SparseMatrix<double>::InnerIterator it(adjacency, i); it; ++it) {
+      entries.emplace_back(i, it.row(), 0.5 / degree);
+    }
+  }
+  averaging.setFromTriplets(entries.begin(), entries.end());
+  return averaging;
+}
+
 double smoothstep(double t) {
   t = std::clamp(t, 0.0, 1.0);
   return t * t * (3.0 - 2.0 * t);
@@ -90,7 +117,7 @@ Quaterniond same_hemisphere(const Quaterniond& q, const Quaterniond& reference) 
 
 }  // namespace
 
-MuscleBinding::MuscleBinding(const Eigen::MatrixX3d& rest_vertices,
+MuscleBinding::MuscleBinding(const Eigen::MatrixX3d& rest_vertices, const Eigen::MatrixX3i& faces,
                              const std::vector<LinePath>& rest_lines,
                              std::vector<AttachmentBone> attachments, const BindingOptions& options)
     : rest_(rest_vertices), attachments_(std::move(attachments)), options_(options) {
@@ -121,6 +148,19 @@ MuscleBinding::MuscleBinding(const Eigen::MatrixX3d& rest_vertices,
     lines_.push_back(std::move(binding));
   }
   for (LineBinding& binding : lines_) binding.weight = binding.weight.cwiseQuotient(total_weight);
+  if (options.smoothing_iterations < 0) throw InvalidInputError("muscle binding: smoothing_iterations must be >= 0");
+  if (options.smoothing_iterations > 0 && faces.rows() > 0) {
+    if (faces.minCoeff() < 0 || faces.maxCoeff() >= n) {
+      throw InvalidInputError("muscle binding: a face index is outside the vertices");
+    }
+    const Eigen::SparseMatrix<double> averaging = neighbour_average(faces, n);
+    for (LineBinding& binding : lines_) {
+      for (int iteration = 0; iteration < options.smoothing_iterations; ++iteration) {
+        binding.fraction = averaging * binding.fraction;
+        binding.weight = averaging * binding.weight;
+      }
+    }
+  }
 
   nearest_attachment_ = Eigen::VectorXi::Constant(n, -1);
   bone_blend_ = Eigen::VectorXd::Zero(n);

@@ -31,6 +31,10 @@ struct BindingOptions {
   double attachment_band_mm = 8.0;  // > 0
   double tangent_window_mm = 15.0;  // > 0
   double line_softening_mm = 5.0;   // > 0: d offset in the line weights
+  // Neighbour averages of the fractions and line weights over the surface:
+  // the closest point on a kinked path jumps between segments, its fraction
+  // and the targets with it; smoothed, the targets are continuous.
+  int smoothing_iterations = 0;  // >= 0 (0: none; more shifts the attachments)
 };
 
 // A bone the muscle attaches to, as the binding sees it: its index in the
@@ -52,11 +56,13 @@ struct LinePath {
 class MuscleBinding {
  public:
   // rest_vertices  #V by 3, the muscle at rest (atlas frame, mm)
+  // faces          its triangles (for the smoothing)
   // rest_lines     the action lines' rest paths (at least one; in the same frame)
   // attachments    bones the muscle attaches to (may be empty)
   // Throws InvalidInputError when a line has fewer than 2 points or zero
   // length, sizes disagree, or the options are not positive.
-  MuscleBinding(const Eigen::MatrixX3d& rest_vertices, const std::vector<LinePath>& rest_lines,
+  MuscleBinding(const Eigen::MatrixX3d& rest_vertices, const Eigen::MatrixX3i& faces,
+                const std::vector<LinePath>& rest_lines,
                 std::vector<AttachmentBone> attachments, const BindingOptions& options = {});
 
   struct Targets {

@@ -199,7 +199,7 @@ class MuscleWrapper {
       attachments.push_back(
           {b, contacts_->rest_distance(static_cast<std::size_t>(b)).cwiseMax(0.0)});
     }
-    binding_ = std::make_unique<MuscleBinding>(surface.V, rest_lines, std::move(attachments),
+    binding_ = std::make_unique<MuscleBinding>(surface.V, surface.F, rest_lines, std::move(attachments),
                                                options.binding);
     deformer_ = std::make_unique<VolumeDeformer>(surface, options.deformer);
     result_.rest_volume_mm3 = deformer_->rest_volume();
@@ -217,7 +217,7 @@ class MuscleWrapper {
     std::vector<Contact> contacts = contacts_carried_;
     DeformResult solved;
     std::vector<Isometry3d> poses;
-    const int stages = options_.intermediate_poses + 1;
+    const int stages = (frame_index == 0 ? options_.first_frame_intermediate_poses : options_.intermediate_poses) + 1;
     for (int stage = 1; stage <= stages; ++stage) {
       const double t = static_cast<double>(stage) / stages;
       const VectorXd q_stage = (1.0 - t) * previous_q_ + t * q;

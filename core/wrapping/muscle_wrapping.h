@@ -12,8 +12,8 @@
 // paths and moment arms, the targets, the volume-constrained solve with the
 // contacts found inside it. Contacts of the previous frame start the next
 // one, carried by their bones; `intermediate_poses` > 0 solves at that many
-// coordinate vectors between the previous frame (the rest pose before the
-// first) and this one first (the interpolated variant, for large motions:
+// coordinate vectors between the previous frame and this one first (for the
+// first frame, `first_frame_intermediate_poses` from the rest pose) (the interpolated variant, for large motions:
 // a vertex is pushed out of a bone on the side it entered). Muscles are
 // independent and run on `threads` threads.
 
@@ -35,7 +35,11 @@ namespace mmm::wrapping {
 struct MuscleWrappingOptions {
   Eigen::Index target_faces = 10000;  // wrapping resolution; 0: the full mesh
   bool bone_contacts = true;          // impenetrability with the bones
-  int intermediate_poses = 0;         // >= 0
+  int intermediate_poses = 0;         // >= 0, between consecutive frames
+  // Between the rest pose and the first frame, usually far apart: a vertex
+  // driven deep into a bone in one step is projected out across a crowd of
+  // others (folds); in small steps it is pushed out where it enters.
+  int first_frame_intermediate_poses = 8;  // >= 0
   std::vector<std::string> muscles;   // empty: every muscle of the atlas
   std::vector<std::string> moment_arm_coordinates = {"hip_flexion_r", "hip_adduction_r",
                                                      "hip_rotation_r", "knee_angle_r"};

@@ -129,7 +129,7 @@ namespace {
 // identity on A's factor: A_C^-1 R = A^-1 R - Z S^-1 (A^-1 R)_C with
 // Z = A^-1 E and S = I / c + Z_C (one back-substitution per contact); beyond
 // it, A + c E E^T is factored anew (numeric factorisation only: same pattern).
-constexpr std::size_t kWoodburyContacts = 24;
+constexpr std::size_t kWoodburyContacts = 64;
 
 class ContactSolver {
  public:
