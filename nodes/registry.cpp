@@ -9,6 +9,7 @@
 #include "nodes/measure_mesh.h"
 #include "nodes/scale_atlas.h"
 #include "nodes/static_trial_landmarks.h"
+#include "nodes/wrap_muscles.h"
 #include "worklists/landmark_task.h"
 
 namespace mmm::nodes {
@@ -25,6 +26,7 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<StaticTrialLandmarks>();
   registry.add<ScaleAtlas>();
   registry.add<FuseMotion>();
+  registry.add<WrapMuscles>();
   return registry;
 }
 

@@ -107,7 +107,7 @@ TEST(WorkflowCliTest, NodesJsonIsMachineReadable) {
   EXPECT_EQ(names, (std::vector<std::string>{"decimate_mesh", "fuse_motion", "import_markups",
                                              "landmark_report", "landmark_station", "load_mesh",
                                              "load_radiographs", "measure_mesh", "scale_atlas",
-                                             "static_trial_landmarks"}))
+                                             "static_trial_landmarks", "wrap_muscles"}))
       << "sorted by name";
   const auto& decimate = json["node_types"][0];
   EXPECT_EQ(decimate["name"], "decimate_mesh");

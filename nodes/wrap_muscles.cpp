@@ -1,0 +1,368 @@
+#include "nodes/wrap_muscles.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/atlas/atlas_io.h"
+#include "core/directory_bundle.h"
+#include "core/errors.h"
+#include "core/mesh/io/mesh_io.h"
+#include "core/mesh/io/vtp_series.h"
+#include "core/motion/motion_io.h"
+#include "core/plot/svg_plot.h"
+#include "core/wrapping/muscle_wrapping.h"
+
+namespace mmm::nodes {
+namespace {
+
+std::vector<std::string> split_names(const std::string& text) {
+  std::vector<std::string> names;
+  std::stringstream stream(text);
+  std::string name;
+  while (std::getline(stream, name, ',')) {
+    name.erase(0, name.find_first_not_of(" \t"));
+    name.erase(name.find_last_not_of(" \t") + 1);
+    if (!name.empty()) names.push_back(name);
+  }
+  return names;
+}
+
+wrapping::MuscleWrappingOptions options_from(const workflow::NodeContext& context) {
+  wrapping::MuscleWrappingOptions options;
+  options.target_faces = context.integer("target_faces");
+  options.bone_contacts = context.flag("bone_contacts");
+  options.intermediate_poses = static_cast<int>(context.integer("intermediate_poses"));
+  options.first_frame_intermediate_poses =
+      static_cast<int>(context.integer("first_frame_intermediate_poses"));
+  options.muscles = split_names(context.text("muscles"));
+  options.threads = static_cast<int>(context.integer("threads"));
+  options.deformer.stiffness_length_mm = context.number("stiffness_length_mm");
+  options.contacts.tolerance_mm = context.number("contact_tolerance_mm");
+  options.contacts.clearance_mm = context.number("contact_clearance_mm");
+  return options;
+}
+
+std::string fixed(double value, int decimals) {
+  std::vector<char> buffer(64);
+  std::snprintf(buffer.data(), buffer.size(), "%.*f", decimals, value);
+  return buffer.data();
+}
+
+std::string metrics_csv(const wrapping::MuscleWrapping& wrapped) {
+  std::string csv =
+      "muscle,frame,time_s,volume_error_percent,max_depth_mm,vertices_inside,vertices_deeper,"
+      "deepest_bone,"
+      "smoothness_change_percent,contacts,contact_rounds,volume_iterations,converged,ms\n";
+  for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
+    for (std::size_t f = 0; f < muscle.frames.size(); ++f) {
+      const wrapping::MuscleFrameMetrics& m = muscle.frames[f];
+      csv += muscle.name + "," + std::to_string(f) + "," +
+             fixed(wrapped.times(static_cast<Eigen::Index>(f)), 4) + "," +
+             fixed(m.volume_error_percent, 8) + "," + fixed(m.max_depth_mm, 3) + "," +
+             std::to_string(m.vertices_inside) + "," + std::to_string(m.vertices_deeper) + "," +
+             m.deepest_bone + "," + fixed(m.smoothness_change_percent, 2) + "," +
+             std::to_string(m.contacts) + "," + std::to_string(m.contact_rounds) + "," +
+             std::to_string(m.volume_iterations) + "," + (m.converged ? "1" : "0") + "," +
+             fixed(1000.0 * m.seconds, 2) + "\n";
+    }
+  }
+  return csv;
+}
+
+std::string lines_csv(const wrapping::MuscleWrapping& wrapped) {
+  std::string csv = "muscle,line,frame,time_s,length_mm";
+  for (const std::string& coordinate : wrapped.moment_arm_coordinates)
+    csv += ",moment_arm_" + coordinate + "_mm";
+  csv += "\n";
+  for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
+    for (const wrapping::WrappedLine& line : muscle.lines) {
+      for (std::size_t f = 0; f < line.lengths_mm.size(); ++f) {
+        csv += muscle.name + "," + line.name + "," + std::to_string(f) + "," +
+               fixed(wrapped.times(static_cast<Eigen::Index>(f)), 4) + "," +
+               fixed(line.lengths_mm[f], 3);
+        for (Eigen::Index c = 0; c < line.moment_arms_mm.cols(); ++c) {
+          const double arm = line.moment_arms_mm(static_cast<Eigen::Index>(f), c);
+          csv += "," + (std::isfinite(arm) ? fixed(arm, 3) : std::string());
+        }
+        csv += "\n";
+      }
+    }
+  }
+  return csv;
+}
+
+std::string metrics_svg(const wrapping::MuscleWrapping& wrapped) {
+  auto chart = [](const char* title, const char* y_label) {
+    plot::Chart c;
+    c.title = title;
+    c.x_label = "time (s)";
+    c.y_label = y_label;
+    return c;
+  };
+  plot::Chart volume = chart("Volume error", "volume error (%)");
+  plot::Chart depth = chart("Deepest vertex inside a bone", "depth (mm)");
+  plot::Chart time = chart("Time per muscle-frame", "time (ms)");
+  plot::Chart smooth = chart("Surface bending vs rest", "change (%)");
+  depth.y_reference_lines = {1.0};
+  volume.y_reference_lines = {-0.5, 0.5};
+  const std::vector<double> times(wrapped.times.data(),
+                                  wrapped.times.data() + wrapped.times.size());
+  for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
+    plot::Series v;
+    v.label = muscle.name;
+    v.x = times;
+    plot::Series d;
+    d.label = muscle.name;
+    d.x = times;
+    plot::Series t;
+    t.label = muscle.name;
+    t.x = times;
+    plot::Series s;
+    s.label = muscle.name;
+    s.x = times;
+    for (const wrapping::MuscleFrameMetrics& m : muscle.frames) {
+      v.y.push_back(m.volume_error_percent);
+      d.y.push_back(m.max_depth_mm);
+      t.y.push_back(1000.0 * m.seconds);
+      s.y.push_back(m.smoothness_change_percent);
+    }
+    volume.series.push_back(std::move(v));
+    depth.series.push_back(std::move(d));
+    time.series.push_back(std::move(t));
+    smooth.series.push_back(std::move(s));
+  }
+  plot::Layout layout;
+  layout.columns = 2;
+  layout.panel_width = 560;
+  layout.panel_height = 420;
+  layout.title = "Muscle wrapping over the trial (energy pathway)";
+  return plot::svg_small_multiples({volume, depth, time, smooth}, layout);
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
+                         const wrapping::MuscleWrappingOptions& options) {
+  nlohmann::json muscles = nlohmann::json::array();
+  std::vector<double> all_ms;
+  double worst_volume = 0.0;
+  double worst_depth = 0.0;
+  int unconverged = 0;
+  for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
+    double volume = 0.0;
+    double depth = 0.0;
+    double smooth = 0.0;
+    int deeper = 0;
+    std::vector<double> ms;
+    for (const wrapping::MuscleFrameMetrics& m : muscle.frames) {
+      volume = std::max(volume, std::abs(m.volume_error_percent));
+      depth = std::max(depth, m.max_depth_mm);
+      smooth = std::max(smooth, m.smoothness_change_percent);
+      deeper += m.vertices_deeper;
+      ms.push_back(1000.0 * m.seconds);
+      if (!m.converged) ++unconverged;
+    }
+    all_ms.insert(all_ms.end(), ms.begin(), ms.end());
+    worst_volume = std::max(worst_volume, volume);
+    worst_depth = std::max(worst_depth, depth);
+    muscles.push_back({{"muscle", muscle.name},
+                       {"faces", muscle.rest.F.rows()},
+                       {"rest_volume_mm3", muscle.rest_volume_mm3},
+                       {"rest_max_depth_mm", muscle.rest_penetration.max_depth_mm},
+                       {"max_abs_volume_error_percent", volume},
+                       {"max_depth_mm", depth},
+                       {"vertex_frames_deeper_than_tolerance", deeper},
+                       {"max_smoothness_change_percent", smooth},
+                       {"median_ms_per_frame", median(ms)},
+                       {"setup_s", muscle.setup_seconds}});
+  }
+  return {{"frames", wrapped.times.size()},
+          {"muscles", muscles},
+          {"threads", wrapped.threads},
+          {"seconds", wrapped.seconds},
+          {"median_ms_per_muscle_frame", median(all_ms)},
+          {"max_abs_volume_error_percent", worst_volume},
+          {"max_depth_mm", worst_depth},
+          {"unconverged_muscle_frames", unconverged},
+          {"targets",
+           {{"volume_error_within_0.5_percent", worst_volume <= 0.5},
+            {"depth_within_1_mm", worst_depth <= 1.0},
+            {"whole_trial_within_60_s", wrapped.seconds <= 60.0}}},
+          {"options",
+           {{"target_faces", options.target_faces},
+            {"bone_contacts", options.bone_contacts},
+            {"intermediate_poses", options.intermediate_poses},
+            {"first_frame_intermediate_poses", options.first_frame_intermediate_poses},
+            {"stiffness_length_mm", options.deformer.stiffness_length_mm},
+            {"contact_tolerance_mm", options.contacts.tolerance_mm},
+            {"contact_clearance_mm", options.contacts.clearance_mm}}}};
+}
+
+std::string animation_bundle(const workflow::NodeContext& context,
+                             const wrapping::MuscleWrapping& wrapped, const atlas::Atlas& atlas,
+                             const std::filesystem::path& atlas_dir, const std::string& bone_level,
+                             int stride) {
+  const std::filesystem::path folder = context.scratch_dir() / "animation";
+  std::filesystem::remove_all(folder);
+  mesh::VtpSeriesWriter series(folder, "wrapping");
+  std::vector<mesh::IndexedMesh> bones;
+  for (const std::string& name : wrapped.bone_names) {
+    const atlas::Bone* bone = atlas.find_bone(name);
+    const atlas::MeshLevel* chosen = &bone->meshes.front();
+    for (const atlas::MeshLevel& level : bone->meshes) {
+      if (level.level == bone_level) chosen = &level;
+    }
+    bones.push_back(mesh::read_mesh(atlas_dir / chosen->file));
+  }
+  for (Eigen::Index k = 0; k < wrapped.times.size(); k += stride) {
+    const double t = wrapped.times(k);
+    const auto frame = static_cast<int>(k / stride);
+    const auto f = static_cast<std::size_t>(k);
+    for (std::size_t b = 0; b < bones.size(); ++b) {
+      mesh::IndexedMesh moved = bones[b];
+      const Eigen::Isometry3d& pose = wrapped.bone_poses[f][b];
+      for (Eigen::Index v = 0; v < moved.V.rows(); ++v) {
+        moved.V.row(v) = (pose * Eigen::Vector3d(moved.V.row(v).transpose())).transpose();
+      }
+      series.add_surface(t, frame, wrapped.bone_names[b], moved);
+    }
+    mesh::Polylines lines;
+    std::vector<Eigen::Vector3d> points;
+    for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
+      mesh::IndexedMesh surface = muscle.rest;
+      surface.V = muscle.positions[f].cast<double>();
+      series.add_surface(t, frame, muscle.name, surface);
+      for (const wrapping::WrappedLine& line : muscle.lines) {
+        std::vector<int> indices;
+        for (const Eigen::Vector3d& p : line.paths[f]) {
+          indices.push_back(static_cast<int>(points.size()));
+          points.push_back(p);
+        }
+        lines.lines.push_back(std::move(indices));
+      }
+    }
+    lines.points.resize(static_cast<Eigen::Index>(points.size()), 3);
+    for (std::size_t i = 0; i < points.size(); ++i)
+      lines.points.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
+    if (!lines.lines.empty()) series.add_polylines(t, frame, "action_lines", lines);
+  }
+  series.finish();
+  return pack_directory(folder);
+}
+
+}  // namespace
+
+workflow::NodeSpec WrapMuscles::spec() {
+  using workflow::port::Atlas;
+  using workflow::port::BonePoses;
+  using workflow::port::File;
+  using workflow::port::Report;
+  const wrapping::MuscleWrappingOptions d;
+  return workflow::NodeSpec{"wrap_muscles", 1,
+                            "Muscle wrapping over a fused motion (energy pathway): per frame, "
+                            "action lines re-routed on the "
+                            "moving skeleton; each muscle surface deformed around them with its "
+                            "volume held exactly (Gauss-Newton "
+                            "with a Lagrange multiplier) and contacts found inside the iterations "
+                            "keeping it out of the bones"}
+      .input<Atlas>("atlas", "The (scaled) atlas the motion drives")
+      .input<BonePoses>("motion", "Fused motion of this atlas (fuse_motion with the atlas input)")
+      .param<std::int64_t>(
+          "target_faces", d.target_faces,
+          "Wrapping resolution: each muscle's full mesh decimated to this many faces "
+          "(0: the full mesh)",
+          {.min = 0, .max = 1000000})
+      .param<bool>("bone_contacts", d.bone_contacts,
+                   "Keep the muscles out of the bones (impenetrability)")
+      .param<std::int64_t>("intermediate_poses", d.intermediate_poses,
+                           "Interpolated variant: poses solved between consecutive frames first",
+                           {.min = 0, .max = 50})
+      .param<std::int64_t>("first_frame_intermediate_poses", d.first_frame_intermediate_poses,
+                           "Poses solved between the rest pose and the first frame",
+                           {.min = 0, .max = 100})
+      .param<std::string>("muscles", "",
+                          "Comma-separated muscle names; empty: every muscle of the atlas")
+      .param<double>("stiffness_length_mm", d.deformer.stiffness_length_mm,
+                     "How far a local push (a contact) spreads over the surface",
+                     {.min = 0.5, .max = 500}, "mm")
+      .param<double>("contact_tolerance_mm", d.contacts.tolerance_mm,
+                     "A vertex deeper than this in a bone becomes a contact", {.min = 0, .max = 5},
+                     "mm")
+      .param<double>("contact_clearance_mm", d.contacts.clearance_mm,
+                     "Contacts are pinned this far outside the bone", {.min = 0, .max = 5}, "mm")
+      .param<std::int64_t>("threads", 0, "Worker threads (muscles in parallel); 0: the machine's",
+                           {.min = 0, .max = 64})
+      .param<std::int64_t>(
+          "animation_stride", 5,
+          "The animation holds every n-th frame (ASCII .vtp: every frame of 21 muscles "
+          "over a 2 s walk is ~1.8 GB)",
+          {.min = 1, .max = 1000})
+      .param<std::string>("bone_level", "lod2",
+                          "Atlas mesh level of the bones drawn in the animation")
+      .output<File>("animation",
+                    "Folder bundle of a ParaView animation (wrapping.pvd + .vtp per frame)")
+      .output<File>(
+          "metrics",
+          "CSV per muscle and frame: volume error, penetration, contacts, smoothness, time")
+      .output<File>("lines", "CSV per action line and frame: length and moment arms (hip, knee)")
+      .output<File>("plot", "SVG: volume error, penetration depth, time and bending per frame")
+      .output<Report>("report", "Per-muscle summaries, targets, timings");
+}
+
+void WrapMuscles::run(workflow::NodeContext& context) {
+  const auto started = std::chrono::steady_clock::now();
+  context.progress(0, 3, "reading the atlas and the motion");
+  const std::filesystem::path atlas_dir = context.scratch_dir() / "atlas";
+  unpack_directory(context.input_bytes("atlas"), atlas_dir, "input 'atlas'");
+  const atlas::Atlas atlas = atlas::read_atlas(atlas_dir);
+  const auto motion_bytes = context.input_bytes("motion");
+  const std::string motion_text(motion_bytes.begin(), motion_bytes.end());
+  nlohmann::json motion_json;
+  try {
+    motion_json = nlohmann::json::parse(motion_text);
+  } catch (const nlohmann::json::exception& e) {
+    throw InvalidInputError("wrap_muscles: input 'motion' is not JSON (" + std::string(e.what()) +
+                            "); hint: connect fuse_motion's 'motion' output");
+  }
+  const motion::FusedMotion fused =
+      motion::motion_from_json(motion_json, "wrap_muscles: input 'motion'");
+  if (motion_json.value("model_kind", "") != "atlas") {
+    throw InvalidInputError(
+        "wrap_muscles: input 'motion' drives an OpenSim model, not an atlas; hint: give "
+        "fuse_motion the atlas input (and the model to retarget from)");
+  }
+  const wrapping::MuscleWrappingOptions options = options_from(context);
+  context.progress(
+      1, 3,
+      "wrapping " +
+          std::to_string(options.muscles.empty() ? atlas.muscles.size() : options.muscles.size()) +
+          " muscles over " + std::to_string(fused.num_frames()) + " frames");
+  const wrapping::MuscleWrapping wrapped = wrapping::wrap_muscles(atlas, atlas_dir, fused, options);
+  nlohmann::json report = report_of(wrapped, options);
+  context.info("wrapped in " + fixed(wrapped.seconds, 1) + " s: max volume error " +
+               fixed(report["max_abs_volume_error_percent"].get<double>(), 6) + " %, max depth " +
+               fixed(report["max_depth_mm"].get<double>(), 2) + " mm");
+  context.progress(2, 3, "writing the outputs");
+  context.set_output("metrics", metrics_csv(wrapped));
+  context.set_output("lines", lines_csv(wrapped));
+  context.set_output("plot", metrics_svg(wrapped));
+  context.set_output(
+      "animation", animation_bundle(context, wrapped, atlas, atlas_dir, context.text("bone_level"),
+                                    static_cast<int>(context.integer("animation_stride"))));
+  report["node_seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  context.set_output("report", report.dump(2));
+  context.progress(3, 3, "done");
+}
+
+}  // namespace mmm::nodes
