@@ -21,9 +21,9 @@ double distance_to_box(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& p)
 
 }  // namespace
 
-BoneContacts::BoneContacts(const Eigen::MatrixX3d& rest_vertices, std::vector<PosableBone> bones,
+BoneContacts::BoneContacts(Eigen::MatrixX3d rest_vertices, std::vector<PosableBone> bones,
                            const ContactOptions& options)
-    : rest_(rest_vertices), bones_(std::move(bones)), options_(options) {
+    : rest_(std::move(rest_vertices)), bones_(std::move(bones)), options_(options) {
   if (!(options.tolerance_mm >= 0 && options.clearance_mm >= 0)) {
     throw InvalidInputError("bone contacts: tolerance_mm and clearance_mm must be >= 0");
   }

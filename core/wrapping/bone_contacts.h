@@ -41,7 +41,7 @@ struct PenetrationMetrics {
 class BoneContacts {
  public:
   // rest_vertices: the muscle at rest, in the bones' rest frame (mm).
-  BoneContacts(const Eigen::MatrixX3d& rest_vertices, std::vector<PosableBone> bones,
+  BoneContacts(Eigen::MatrixX3d rest_vertices, std::vector<PosableBone> bones,
                const ContactOptions& options = {});
 
   // Vertices of x (frame, mm) deeper than the tolerance in a bone posed by

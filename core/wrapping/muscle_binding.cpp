@@ -117,10 +117,10 @@ Quaterniond same_hemisphere(const Quaterniond& q, const Quaterniond& reference) 
 
 }  // namespace
 
-MuscleBinding::MuscleBinding(const Eigen::MatrixX3d& rest_vertices, const Eigen::MatrixX3i& faces,
+MuscleBinding::MuscleBinding(Eigen::MatrixX3d rest_vertices, const Eigen::MatrixX3i& faces,
                              const std::vector<LinePath>& rest_lines,
                              std::vector<AttachmentBone> attachments, const BindingOptions& options)
-    : rest_(rest_vertices), attachments_(std::move(attachments)), options_(options) {
+    : rest_(std::move(rest_vertices)), attachments_(std::move(attachments)), options_(options) {
   if (!(options.attachment_band_mm > 0 && options.tangent_window_mm > 0 &&
         options.line_softening_mm > 0)) {
     throw InvalidInputError(
@@ -148,7 +148,8 @@ MuscleBinding::MuscleBinding(const Eigen::MatrixX3d& rest_vertices, const Eigen:
     lines_.push_back(std::move(binding));
   }
   for (LineBinding& binding : lines_) binding.weight = binding.weight.cwiseQuotient(total_weight);
-  if (options.smoothing_iterations < 0) throw InvalidInputError("muscle binding: smoothing_iterations must be >= 0");
+  if (options.smoothing_iterations < 0)
+    throw InvalidInputError("muscle binding: smoothing_iterations must be >= 0");
   if (options.smoothing_iterations > 0 && faces.rows() > 0) {
     if (faces.minCoeff() < 0 || faces.maxCoeff() >= n) {
       throw InvalidInputError("muscle binding: a face index is outside the vertices");

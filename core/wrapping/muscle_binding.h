@@ -61,9 +61,9 @@ class MuscleBinding {
   // attachments    bones the muscle attaches to (may be empty)
   // Throws InvalidInputError when a line has fewer than 2 points or zero
   // length, sizes disagree, or the options are not positive.
-  MuscleBinding(const Eigen::MatrixX3d& rest_vertices, const Eigen::MatrixX3i& faces,
-                const std::vector<LinePath>& rest_lines,
-                std::vector<AttachmentBone> attachments, const BindingOptions& options = {});
+  MuscleBinding(Eigen::MatrixX3d rest_vertices, const Eigen::MatrixX3i& faces,
+                const std::vector<LinePath>& rest_lines, std::vector<AttachmentBone> attachments,
+                const BindingOptions& options = {});
 
   struct Targets {
     Eigen::MatrixX3d positions;              // #V by 3 (mm)

@@ -195,12 +195,13 @@ class MuscleWrapper {
       attachment_bones.insert(line.insertion_pose_index);
     }
     std::vector<AttachmentBone> attachments;
+    attachments.reserve(attachment_bones.size());
     for (const int b : attachment_bones) {
       attachments.push_back(
           {b, contacts_->rest_distance(static_cast<std::size_t>(b)).cwiseMax(0.0)});
     }
-    binding_ = std::make_unique<MuscleBinding>(surface.V, surface.F, rest_lines, std::move(attachments),
-                                               options.binding);
+    binding_ = std::make_unique<MuscleBinding>(surface.V, surface.F, rest_lines,
+                                               std::move(attachments), options.binding);
     deformer_ = std::make_unique<VolumeDeformer>(surface, options.deformer);
     result_.rest_volume_mm3 = deformer_->rest_volume();
     result_.rest_penetration = contacts_->measure(
@@ -217,7 +218,9 @@ class MuscleWrapper {
     std::vector<Contact> contacts = contacts_carried_;
     DeformResult solved;
     std::vector<Isometry3d> poses;
-    const int stages = (frame_index == 0 ? options_.first_frame_intermediate_poses : options_.intermediate_poses) + 1;
+    const int stages =
+        (frame_index == 0 ? options_.first_frame_intermediate_poses : options_.intermediate_poses) +
+        1;
     for (int stage = 1; stage <= stages; ++stage) {
       const double t = static_cast<double>(stage) / stages;
       const VectorXd q_stage = (1.0 - t) * previous_q_ + t * q;
@@ -255,7 +258,7 @@ class MuscleWrapper {
     metrics.contact_rounds = solved.contact_rounds;
     metrics.volume_iterations = solved.volume_iterations;
     metrics.converged = solved.converged;
-    result_.positions.push_back(solved.x.cast<float>());
+    result_.positions.emplace_back(solved.x.cast<float>());
     metrics.seconds = seconds_since(start);
     result_.frames.push_back(metrics);
   }

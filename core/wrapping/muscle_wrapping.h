@@ -13,9 +13,9 @@
 // contacts found inside it. Contacts of the previous frame start the next
 // one, carried by their bones; `intermediate_poses` > 0 solves at that many
 // coordinate vectors between the previous frame and this one first (for the
-// first frame, `first_frame_intermediate_poses` from the rest pose) (the interpolated variant, for large motions:
-// a vertex is pushed out of a bone on the side it entered). Muscles are
-// independent and run on `threads` threads.
+// first frame, `first_frame_intermediate_poses` from the rest pose) (the interpolated variant, for
+// large motions: a vertex is pushed out of a bone on the side it entered). Muscles are independent
+// and run on `threads` threads.
 
 #include <Eigen/Core>
 #include <filesystem>
@@ -40,7 +40,7 @@ struct MuscleWrappingOptions {
   // driven deep into a bone in one step is projected out across a crowd of
   // others (folds); in small steps it is pushed out where it enters.
   int first_frame_intermediate_poses = 8;  // >= 0
-  std::vector<std::string> muscles;   // empty: every muscle of the atlas
+  std::vector<std::string> muscles;        // empty: every muscle of the atlas
   std::vector<std::string> moment_arm_coordinates = {"hip_flexion_r", "hip_adduction_r",
                                                      "hip_rotation_r", "knee_angle_r"};
   int threads = 0;  // 0: the hardware's

@@ -50,6 +50,7 @@ TEST(BoneContactsTest, TheCulledQueryFindsWhatBruteForceFinds) {
         expected.push_back(static_cast<int>(i));
     }
     std::vector<int> got;
+    got.reserve(found.size());
     for (const Contact& c : found) got.push_back(c.vertex);
     std::sort(got.begin(), got.end());
     EXPECT_EQ(got, expected) << "trial " << trial;
