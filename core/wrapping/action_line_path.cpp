@@ -59,6 +59,7 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
   motion::SkeletonPose pose(skeleton);
   pose.set(q);
   std::vector<Eigen::Vector3d> anchors;
+  std::vector<std::string> anchor_bones;
   ActionLinePath path;
   for (const atlas::PathPoint& point : line.points) {
     const int body = body_of(skeleton, point.bone, what + " point " + point.name);
@@ -77,12 +78,14 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
       local = (bone != nullptr ? bone->frame : Eigen::Isometry3d::Identity()) * in_bone;
     }
     anchors.push_back(pose.point(body, local));
+    anchor_bones.push_back(point.bone);
     path.active.push_back(point.name);
   }
   if (anchors.size() < 2) {
     throw InvalidInputError(what + ": fewer than 2 path points are active at this pose");
   }
   std::vector<Obstacle> obstacles;
+  std::vector<std::string> obstacle_bones;
   for (const std::string& name : line.wrap_obstacles) {
     const auto found = std::find_if(muscle.wrap_obstacles.begin(), muscle.wrap_obstacles.end(),
                                     [&](const atlas::WrapObstacle& o) { return o.name == name; });
@@ -90,23 +93,32 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
       throw unknown_obstacle(what, name, muscle.name);
     }
     obstacles.push_back(posed_obstacle(*found, pose, skeleton, what));
+    obstacle_bones.push_back(found->bone);
   }
   path.points.push_back(anchors.front());
+  path.point_bones.push_back(anchor_bones.front());
+  path.point_names.push_back(path.active.front());
   for (std::size_t i = 1; i < anchors.size(); ++i) {
     // The first listed obstacle this segment would pass through.
     WrapResult chosen;
     chosen.points = {anchors[i - 1], anchors[i]};
     chosen.length = (anchors[i] - anchors[i - 1]).norm();
-    for (const Obstacle& obstacle : obstacles) {
-      const WrapResult wrap = wrap_segment(anchors[i - 1], anchors[i], obstacle, options.wrap);
+    std::string wrapped_on;
+    for (std::size_t o = 0; o < obstacles.size(); ++o) {
+      const WrapResult wrap = wrap_segment(anchors[i - 1], anchors[i], obstacles[o], options.wrap);
       path.inside_obstacle = path.inside_obstacle || wrap.inside;
       if (wrap.wrapped) {
         chosen = wrap;
+        wrapped_on = obstacle_bones[o];
         ++path.wraps;
         break;
       }
     }
     path.points.insert(path.points.end(), chosen.points.begin() + 1, chosen.points.end());
+    path.point_bones.insert(path.point_bones.end(), chosen.points.size() - 2, wrapped_on);
+    path.point_bones.push_back(anchor_bones[i]);
+    path.point_names.insert(path.point_names.end(), chosen.points.size() - 2, std::string());
+    path.point_names.push_back(path.active[i]);
     path.length += chosen.length;
   }
   return path;

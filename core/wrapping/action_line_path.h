@@ -23,9 +23,13 @@ namespace mmm::wrapping {
 struct ActionLinePath {
   std::vector<Eigen::Vector3d> points;  // the whole path, wrapped parts included (world, mm)
   std::vector<std::string> active;      // names of the path points in use, in order
-  double length = 0.0;                  // mm
-  int wraps = 0;                        // segments that wrapped over an obstacle
-  bool inside_obstacle = false;         // a path point lies inside an obstacle
+  // Per entry of `points`: its path point's name ("" on a wrap) and the bone
+  // carrying it (on a wrap: the obstacle's bone).
+  std::vector<std::string> point_names;
+  std::vector<std::string> point_bones;
+  double length = 0.0;           // mm
+  int wraps = 0;                 // segments that wrapped over an obstacle
+  bool inside_obstacle = false;  // a path point lies inside an obstacle
 };
 
 struct PathOptions {

@@ -81,6 +81,48 @@ void check_line(const LinePath& line, std::size_t index) {
   }
 }
 
+// Rest arc length -> arc length now, piecewise linear between the named
+// points present in both paths (and the two ends); by fraction of the
+// length when either path has no names.
+class ArcMap {
+ public:
+  ArcMap(const std::vector<std::string>& rest_names, const std::vector<double>& rest_arc,
+         const std::vector<std::string>& now_names, const std::vector<double>& now_arc) {
+    rest_.push_back(0.0);
+    now_.push_back(0.0);
+    if (rest_names.size() == rest_arc.size() && now_names.size() == now_arc.size()) {
+      std::size_t from = 1;
+      for (std::size_t i = 1; i + 1 < rest_names.size(); ++i) {
+        if (rest_names[i].empty()) continue;
+        for (std::size_t j = from; j + 1 < now_names.size(); ++j) {
+          if (now_names[j] == rest_names[i] && rest_arc[i] > rest_.back() &&
+              now_arc[j] > now_.back()) {
+            rest_.push_back(rest_arc[i]);
+            now_.push_back(now_arc[j]);
+            from = j + 1;
+            break;
+          }
+        }
+      }
+    }
+    rest_.push_back(rest_arc.back());
+    now_.push_back(now_arc.back());
+  }
+
+  [[nodiscard]] double operator()(double s) const {
+    const auto upper = std::upper_bound(rest_.begin(), rest_.end(), s);
+    const auto k = std::clamp<std::size_t>(static_cast<std::size_t>(upper - rest_.begin()), 1,
+                                           rest_.size() - 1);
+    const double span = rest_[k] - rest_[k - 1];
+    const double t = span > 0 ? (s - rest_[k - 1]) / span : 0.0;
+    return now_[k - 1] + t * (now_[k] - now_[k - 1]);
+  }
+
+ private:
+  std::vector<double> rest_;
+  std::vector<double> now_;
+};
+
 // Half the vertex, half the mean of its neighbours (rows sum to 1).
 Eigen::SparseMatrix<double> neighbour_average(const Eigen::MatrixX3i& faces, Eigen::Index n) {
   std::vector<Eigen::Triplet<double>> edges;
@@ -135,6 +177,8 @@ MuscleBinding::MuscleBinding(Eigen::MatrixX3d rest_vertices, const Eigen::Matrix
     LineBinding binding;
     binding.rest_points = rest_lines[l].points;
     binding.rest_arc = cumulative_arc(binding.rest_points);
+    if (rest_lines[l].point_names.size() == binding.rest_points.size())
+      binding.rest_names = rest_lines[l].point_names;
     binding.fraction.resize(n);
     binding.weight.resize(n);
     for (Eigen::Index i = 0; i < n; ++i) {
@@ -223,13 +267,34 @@ MuscleBinding::Targets MuscleBinding::targets(const std::vector<LinePath>& lines
     const Quaterniond insertion = same_hemisphere(
         Quaterniond(poses[static_cast<std::size_t>(lines[l].insertion_pose_index)].rotation()),
         origin);
+    const ArcMap arc_map(binding.rest_names, binding.rest_arc, lines[l].point_names, arc);
+    // Per path point: its bone's rotation, all in one hemisphere.
+    std::vector<Quaterniond> point_rotations;
+    if (lines[l].point_pose_indices.size() == now.size()) {
+      for (const int index : lines[l].point_pose_indices) {
+        check_index(index);
+        point_rotations.push_back(
+            same_hemisphere(Quaterniond(poses[static_cast<std::size_t>(index)].rotation()),
+                            point_rotations.empty() ? origin : point_rotations.back()));
+      }
+    }
     for (Eigen::Index i = 0; i < n; ++i) {
       const double a = binding.fraction[i];
       const double s0 = a * binding.rest_arc.back();
-      const double st = a * arc.back();
+      const double st = arc_map(s0);
       const Vector3d c0 = point_at(binding.rest_points, binding.rest_arc, s0);
       const Vector3d ct = point_at(now, arc, st);
-      const Quaterniond bones = origin.slerp(a, insertion);
+      Quaterniond bones;
+      if (point_rotations.empty()) {
+        bones = origin.slerp(a, insertion);
+      } else {
+        const auto upper = std::upper_bound(arc.begin(), arc.end(), st);
+        const auto k = std::clamp<std::size_t>(static_cast<std::size_t>(upper - arc.begin()), 1,
+                                               arc.size() - 1);
+        const double span = arc[k] - arc[k - 1];
+        const double t = span > 0 ? std::clamp((st - arc[k - 1]) / span, 0.0, 1.0) : 0.0;
+        bones = point_rotations[k - 1].slerp(t, point_rotations[k]);
+      }
       const Vector3d turned =
           bones * tangent_at(binding.rest_points, binding.rest_arc, s0, options_.tangent_window_mm);
       const Vector3d tangent = tangent_at(now, arc, st, options_.tangent_window_mm);

@@ -10,8 +10,10 @@
 //   line target   c_t(a) + R(a) (X - c_0(a)),  c the path point at fraction
 //                 a of its length (so a stretched line stretches the muscle
 //                 along it), R(a) = R_align * R_bones(a): the carrying bones'
-//                 rotation (origin bone's at a = 0, insertion bone's at a = 1,
-//                 spherically interpolated between) followed by the smallest
+//                 rotation (that of the bones of the path points on either
+//                 side of a, spherically interpolated; without per-point
+//                 bones, origin bone's at a = 0 to insertion bone's at a = 1)
+//                 followed by the smallest
 //                 rotation taking the so-turned rest tangent to the current
 //                 one; tangents are chords over +-`tangent_window_mm` of arc
 //                 length, smooth across the path's kinks
@@ -51,6 +53,16 @@ struct LinePath {
   std::vector<Eigen::Vector3d> points;  // >= 2, world (mm)
   int origin_pose_index = -1;
   int insertion_pose_index = -1;
+  // Optional, one per point: the bone carrying it. The rotation carrying a
+  // vertex is then interpolated between the bones of the two path points
+  // around its fraction (a vastus stays with the femur until its line
+  // crosses the knee), not between origin and insertion.
+  std::vector<int> point_pose_indices;
+  // Optional, one per point: the path point's name ("" for points of a wrap).
+  // Arc lengths are then mapped between the named points present both at
+  // rest and now, so a conditional point switching on or off moves only the
+  // part of the muscle around it; without names, by fraction of the length.
+  std::vector<std::string> point_names;
 };
 
 class MuscleBinding {
@@ -82,8 +94,9 @@ class MuscleBinding {
   struct LineBinding {
     std::vector<Eigen::Vector3d> rest_points;
     std::vector<double> rest_arc;  // cumulative arc length
-    Eigen::VectorXd fraction;      // per vertex
-    Eigen::VectorXd weight;        // per vertex, normalised over lines
+    std::vector<std::string> rest_names;
+    Eigen::VectorXd fraction;  // per vertex
+    Eigen::VectorXd weight;    // per vertex, normalised over lines
   };
   Eigen::MatrixX3d rest_;
   std::vector<LineBinding> lines_;

@@ -280,6 +280,12 @@ class MuscleWrapper {
           bone_index(bones_, line.points.front().bone, "the origin of " + line.name);
       posed.insertion_pose_index =
           bone_index(bones_, line.points.back().bone, "the insertion of " + line.name);
+      posed.point_names = path.point_names;
+      for (const std::string& bone : path.point_bones) {
+        posed.point_pose_indices.push_back(
+            bone.empty() ? posed.point_pose_indices.back()
+                         : bone_index(bones_, bone, "a path point of " + line.name));
+      }
       lines.push_back(std::move(posed));
       if (frame < 0) continue;
       WrappedLine& record = result_.lines[l];
