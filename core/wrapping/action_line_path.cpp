@@ -40,12 +40,12 @@ Obstacle posed_obstacle(const atlas::WrapObstacle& source, const motion::Skeleto
       obstacle.shape = ObstacleShape::kCylinder;
       break;
     case atlas::WrapShape::kEllipsoid:
-      throw InvalidInputError(what + ": obstacle '" + source.name +
-                              "' is an ellipsoid, which the obstacle-set method here does not "
-                              "wrap (spheres and cylinders)");
+      obstacle.shape = ObstacleShape::kEllipsoid;
+      break;
   }
   obstacle.pose = pose.body_pose(body_of(skeleton, source.bone, what)) * source.pose;
   obstacle.radius = source.radii.x();
+  obstacle.radii = source.radii;
   obstacle.quadrant = source.quadrant;
   return obstacle;
 }

@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "core/errors.h"
+#include "core/wrapping/ellipsoid_geodesic.h"
 
 namespace mmm::wrapping {
 namespace {
@@ -52,14 +53,13 @@ struct Quadrant {
 
 Quadrant parse_quadrant(const std::string& quadrant, ObstacleShape shape) {
   if (quadrant == "all" || quadrant.empty()) return {};
+  const bool has_z = shape != ObstacleShape::kCylinder;
   if (quadrant.size() == 2 && (quadrant[0] == '+' || quadrant[0] == '-') &&
-      (quadrant[1] == 'x' || quadrant[1] == 'y' ||
-       (quadrant[1] == 'z' && shape == ObstacleShape::kSphere))) {
+      (quadrant[1] == 'x' || quadrant[1] == 'y' || (quadrant[1] == 'z' && has_z))) {
     return {quadrant[1] - 'x', quadrant[0] == '+' ? 1.0 : -1.0};
   }
   throw InvalidInputError("wrap obstacle: quadrant '" + quadrant +
-                          "' is not one of all, +x, -x, +y, -y" +
-                          (shape == ObstacleShape::kSphere ? ", +z, -z" : ""));
+                          "' is not one of all, +x, -x, +y, -y" + (has_z ? ", +z, -z" : ""));
 }
 
 // Picks the side: the shorter sweep, or the one whose arc midpoint lies on
@@ -182,16 +182,28 @@ WrapResult wrap_cylinder(const Eigen::Vector3d& p_world, const Eigen::Vector3d& 
 
 WrapResult wrap_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& s,
                         const Obstacle& obstacle, const WrapOptions& options) {
-  if (!(obstacle.radius > 0) || !std::isfinite(obstacle.radius)) {
+  if (obstacle.shape == ObstacleShape::kEllipsoid) {
+    if (!(obstacle.radii.minCoeff() > 0) || !obstacle.radii.allFinite()) {
+      throw InvalidInputError(
+          "wrap obstacle: an ellipsoid's radii (its three semi-axes) must be positive numbers of "
+          "mm");
+    }
+  } else if (!(obstacle.radius > 0) || !std::isfinite(obstacle.radius)) {
     throw InvalidInputError("wrap obstacle: the radius must be a positive number of mm");
   }
   if (!p.allFinite() || !s.allFinite()) {
     throw InvalidInputError("wrap obstacle: the path's end points must be finite");
   }
   const Quadrant quadrant = parse_quadrant(obstacle.quadrant, obstacle.shape);
-  return obstacle.shape == ObstacleShape::kSphere
-             ? wrap_sphere(p, s, obstacle, quadrant, options)
-             : wrap_cylinder(p, s, obstacle, quadrant, options);
+  switch (obstacle.shape) {
+    case ObstacleShape::kSphere:
+      return wrap_sphere(p, s, obstacle, quadrant, options);
+    case ObstacleShape::kCylinder:
+      return wrap_cylinder(p, s, obstacle, quadrant, options);
+    case ObstacleShape::kEllipsoid:
+      break;
+  }
+  return wrap_ellipsoid(p, s, obstacle, options);
 }
 
 }  // namespace mmm::wrapping

@@ -12,6 +12,10 @@
 //            In the xy-plane the path is the 2D sphere case on the circle;
 //            z grows linearly with the unrolled length, so the wrapped part
 //            is a helix and the length is sqrt(L_xy^2 + (z_S - z_P)^2).
+//   ellipsoid (semi-axes radii along its frame's x, y, z): no closed form;
+//            the sphere case in the space where it is the unit sphere gives
+//            the tangent lines and a first path, relaxed numerically onto a
+//            geodesic (ellipsoid_geodesic.h).
 //
 // The path wraps only when the straight segment P-S would pass through the
 // obstacle (for the cylinder: its xy-projection through the circle) and,
@@ -26,13 +30,16 @@
 
 namespace mmm::wrapping {
 
-enum class ObstacleShape { kSphere, kCylinder };
+enum class ObstacleShape { kSphere, kCylinder, kEllipsoid };
 
 struct Obstacle {
   ObstacleShape shape = ObstacleShape::kSphere;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // obstacle frame -> world (mm)
-  double radius = 0.0;                                     // mm, > 0
-  std::string quadrant = "all";  // "all", "+x", "-x", "+y", "-y" (cylinder: x or y only)
+  double radius = 0.0;                                     // sphere, cylinder: mm, > 0
+  // Ellipsoid: semi-axes along the obstacle frame's x, y, z (mm, each > 0).
+  Eigen::Vector3d radii = Eigen::Vector3d::Zero();
+  // "all", "+x", "-x", "+y", "-y", "+z", "-z" (cylinder: x or y only)
+  std::string quadrant = "all";
 };
 
 struct WrapResult {
@@ -40,8 +47,10 @@ struct WrapResult {
   bool inside = false;   // P or S lies inside the obstacle: no wrapping path exists
   Eigen::Vector3d tangent_in = Eigen::Vector3d::Zero();   // T1 (world, mm) when wrapped
   Eigen::Vector3d tangent_out = Eigen::Vector3d::Zero();  // T2
-  double wrap_angle = 0.0;  // rad swept on the obstacle (in the xy-plane for a cylinder)
-  double length = 0.0;      // of the whole path P -> S (mm)
+  // rad swept on the obstacle (in the xy-plane for a cylinder; for an
+  // ellipsoid, the angle its surface normal turns through along the path)
+  double wrap_angle = 0.0;
+  double length = 0.0;  // of the whole path P -> S (mm)
   // The path as a polyline P, T1, points on the surface every
   // `arc_step_mm` at most, T2, S (just P, S when not wrapped).
   std::vector<Eigen::Vector3d> points;
@@ -51,8 +60,9 @@ struct WrapOptions {
   double arc_step_mm = 2.0;  // resolution of the wrapped part of `points`
 };
 
-// Throws InvalidInputError for a non-positive radius, an unknown quadrant
-// or non-finite points.
+// Throws InvalidInputError for a non-positive radius (an ellipsoid: radii),
+// an unknown quadrant or non-finite points; SolverError when an ellipsoid's
+// geodesic cannot be found.
 WrapResult wrap_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& s,
                         const Obstacle& obstacle, const WrapOptions& options = {});
 
