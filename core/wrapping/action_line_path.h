@@ -41,7 +41,7 @@ struct PathOptions {
 // share its bone names with body frames equal to the bones' frames; q its
 // coordinates. Throws InvalidInputError when a point's bone, a coordinate
 // of a conditional or moving point, or a named obstacle is unknown, or an
-// obstacle's shape is not a sphere or cylinder.
+// obstacle has invalid dimensions (e.g. an ellipsoid with a zero semi-axis).
 ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& muscle,
                                 const atlas::ActionLine& line, const motion::Skeleton& skeleton,
                                 const Eigen::VectorXd& q, const PathOptions& options = {});
