@@ -38,6 +38,7 @@
 #include "core/wrapping/action_line_path.h"
 #include "core/wrapping/muscle_wrapping.h"
 #include "core/wrapping/osim_action_lines.h"
+#include "core/wrapping/wrapping_summary.h"
 
 namespace {
 
@@ -109,13 +110,6 @@ const motion::FusedMotion& atlas_walk() {
   return walk;
 }
 
-double median_of(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
 nlohmann::json write_trial_table(std::ostringstream& out) {
   const mmm::wrapping::MuscleWrappingOptions options;
   const wrapping::MuscleWrapping wrapped =
@@ -135,17 +129,12 @@ nlohmann::json write_trial_table(std::ostringstream& out) {
   double worst_depth = 0.0;
   int deeper = 0;
   for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
-    double volume = 0.0;
-    double depth = 0.0;
-    double bending = 0.0;
-    std::vector<double> ms;
-    for (const wrapping::MuscleFrameMetrics& f : muscle.frames) {
-      volume = std::max(volume, std::abs(f.volume_error_percent));
-      depth = std::max(depth, f.max_depth_mm);
-      bending = std::max(bending, f.smoothness_change_percent);
-      deeper += f.vertices_deeper;
-      ms.push_back(1000.0 * f.seconds);
-    }
+    const wrapping::MuscleWrappingSummary summary = wrapping::summarise(muscle);
+    const std::vector<double>& ms = summary.ms_per_frame;
+    const double volume = summary.max_abs_volume_error_percent;
+    const double depth = summary.max_depth_mm;
+    const double bending = summary.max_smoothness_change_percent;
+    deeper += summary.vertex_frames_deeper;
     all_ms.insert(all_ms.end(), ms.begin(), ms.end());
     if (muscle.rest.F.rows() >= 9000) ten_k_ms.insert(ten_k_ms.end(), ms.begin(), ms.end());
     worst_volume = std::max(worst_volume, volume);
@@ -153,14 +142,14 @@ nlohmann::json write_trial_table(std::ostringstream& out) {
     out << std::setw(30) << muscle.name << std::setw(8) << muscle.rest.F.rows() << std::setw(14)
         << std::scientific << std::setprecision(1) << volume << std::fixed << std::setw(12)
         << std::setprecision(2) << depth << std::setw(12) << std::setprecision(0) << bending
-        << std::setw(12) << std::setprecision(1) << median_of(ms) << std::setprecision(2)
+        << std::setw(12) << std::setprecision(1) << wrapping::median(ms) << std::setprecision(2)
         << muscle.setup_seconds << "\n";
     rows.push_back({{"muscle", muscle.name},
                     {"faces", muscle.rest.F.rows()},
                     {"max_abs_volume_error_percent", volume},
                     {"max_depth_mm", depth},
                     {"max_bending_change_percent", bending},
-                    {"median_ms_per_frame", median_of(ms)},
+                    {"median_ms_per_frame", wrapping::median(ms)},
                     {"setup_s", muscle.setup_seconds}});
   }
   out << std::setprecision(3) << "all: max |volume error| " << std::scientific << worst_volume
@@ -170,52 +159,24 @@ nlohmann::json write_trial_table(std::ostringstream& out) {
          "bones), max depth "
       << worst_depth << " mm (target 1), vertex-frames deeper than the contact tolerance " << deeper
       << "\n"
-      << std::setprecision(1) << "median per muscle-frame " << median_of(all_ms)
-      << " ms; 9-10K-face muscles " << median_of(ten_k_ms)
+      << std::setprecision(1) << "median per muscle-frame " << wrapping::median(all_ms)
+      << " ms; 9-10K-face muscles " << wrapping::median(ten_k_ms)
       << " ms (target 50; reference 500 ms without collisions, 23 s with bones, "
       << "20.1 s gluteus maximus)\n"
       << "whole walk " << wrapped.seconds << " s on " << wrapped.threads
       << " threads (target 60 s; reference 188.6 s)\n";
-  // The plot of volume error, depth and time over the walk.
-  auto series_of = [&](auto value) {
-    mmm::plot::Chart chart;
-    chart.x_label = "time (s)";
-    for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
-      mmm::plot::Series s;
-      s.label = muscle.name;
-      for (std::size_t f = 0; f < muscle.frames.size(); ++f) {
-        s.x.push_back(wrapped.times(static_cast<Eigen::Index>(f)));
-        s.y.push_back(value(muscle.frames[f]));
-      }
-      chart.series.push_back(std::move(s));
-    }
-    return chart;
-  };
-  mmm::plot::Chart volume = series_of([](const auto& f) { return f.volume_error_percent; });
-  volume.title = "Volume error";
-  volume.y_label = "volume error (%)";
-  mmm::plot::Chart depth = series_of([](const auto& f) { return f.max_depth_mm; });
-  depth.title = "Deepest vertex inside a bone";
-  depth.y_label = "depth (mm)";
-  depth.y_reference_lines = {1.0};
-  mmm::plot::Chart time = series_of([](const auto& f) { return 1000.0 * f.seconds; });
-  time.title = "Time per muscle-frame";
-  time.y_label = "time (ms)";
-  mmm::plot::Layout layout;
-  layout.columns = 3;
-  layout.panel_width = 520;
-  layout.panel_height = 420;
-  layout.title = "Muscle wrapping over subject01's walk on the default atlas";
+  // The plot of volume error, depth, time and bending over the walk.
   const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
   mmm::plot::write_svg(
-      mmm::plot::svg_small_multiples({volume, depth, time}, layout),
+      wrapping::wrapping_metrics_svg(wrapped,
+                                     "Muscle wrapping over subject01's walk on the default atlas"),
       std::filesystem::path(out_dir != nullptr ? out_dir : ".") / "wrapping_metrics.svg");
   return {{"muscles", rows},
           {"frames", wrapped.times.size()},
           {"threads", wrapped.threads},
           {"whole_walk_s", wrapped.seconds},
-          {"median_ms_per_muscle_frame", median_of(all_ms)},
-          {"median_ms_per_10k_face_muscle_frame", median_of(ten_k_ms)},
+          {"median_ms_per_muscle_frame", wrapping::median(all_ms)},
+          {"median_ms_per_10k_face_muscle_frame", wrapping::median(ten_k_ms)},
           {"max_abs_volume_error_percent", worst_volume},
           {"max_depth_mm", worst_depth},
           {"vertex_frames_deeper_than_tolerance", deeper},

@@ -14,8 +14,8 @@
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/io/vtp_series.h"
 #include "core/motion/motion_io.h"
-#include "core/plot/svg_plot.h"
 #include "core/wrapping/muscle_wrapping.h"
+#include "core/wrapping/wrapping_summary.h"
 
 namespace mmm::nodes {
 namespace {
@@ -96,61 +96,6 @@ std::string lines_csv(const wrapping::MuscleWrapping& wrapped) {
   return csv;
 }
 
-std::string metrics_svg(const wrapping::MuscleWrapping& wrapped) {
-  auto chart = [](const char* title, const char* y_label) {
-    plot::Chart c;
-    c.title = title;
-    c.x_label = "time (s)";
-    c.y_label = y_label;
-    return c;
-  };
-  plot::Chart volume = chart("Volume error", "volume error (%)");
-  plot::Chart depth = chart("Deepest vertex inside a bone", "depth (mm)");
-  plot::Chart time = chart("Time per muscle-frame", "time (ms)");
-  plot::Chart smooth = chart("Surface bending vs rest", "change (%)");
-  depth.y_reference_lines = {1.0};
-  volume.y_reference_lines = {-0.5, 0.5};
-  const std::vector<double> times(wrapped.times.data(),
-                                  wrapped.times.data() + wrapped.times.size());
-  for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
-    plot::Series v;
-    v.label = muscle.name;
-    v.x = times;
-    plot::Series d;
-    d.label = muscle.name;
-    d.x = times;
-    plot::Series t;
-    t.label = muscle.name;
-    t.x = times;
-    plot::Series s;
-    s.label = muscle.name;
-    s.x = times;
-    for (const wrapping::MuscleFrameMetrics& m : muscle.frames) {
-      v.y.push_back(m.volume_error_percent);
-      d.y.push_back(m.max_depth_mm);
-      t.y.push_back(1000.0 * m.seconds);
-      s.y.push_back(m.smoothness_change_percent);
-    }
-    volume.series.push_back(std::move(v));
-    depth.series.push_back(std::move(d));
-    time.series.push_back(std::move(t));
-    smooth.series.push_back(std::move(s));
-  }
-  plot::Layout layout;
-  layout.columns = 2;
-  layout.panel_width = 560;
-  layout.panel_height = 420;
-  layout.title = "Muscle wrapping over the trial (energy pathway)";
-  return plot::svg_small_multiples({volume, depth, time, smooth}, layout);
-}
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
 nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
                          const wrapping::MuscleWrappingOptions& options) {
   nlohmann::json muscles = nlohmann::json::array();
@@ -159,38 +104,27 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
   double worst_depth = 0.0;
   int unconverged = 0;
   for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
-    double volume = 0.0;
-    double depth = 0.0;
-    double smooth = 0.0;
-    int deeper = 0;
-    std::vector<double> ms;
-    for (const wrapping::MuscleFrameMetrics& m : muscle.frames) {
-      volume = std::max(volume, std::abs(m.volume_error_percent));
-      depth = std::max(depth, m.max_depth_mm);
-      smooth = std::max(smooth, m.smoothness_change_percent);
-      deeper += m.vertices_deeper;
-      ms.push_back(1000.0 * m.seconds);
-      if (!m.converged) ++unconverged;
-    }
-    all_ms.insert(all_ms.end(), ms.begin(), ms.end());
-    worst_volume = std::max(worst_volume, volume);
-    worst_depth = std::max(worst_depth, depth);
+    const wrapping::MuscleWrappingSummary summary = wrapping::summarise(muscle);
+    all_ms.insert(all_ms.end(), summary.ms_per_frame.begin(), summary.ms_per_frame.end());
+    worst_volume = std::max(worst_volume, summary.max_abs_volume_error_percent);
+    worst_depth = std::max(worst_depth, summary.max_depth_mm);
+    unconverged += summary.unconverged_frames;
     muscles.push_back({{"muscle", muscle.name},
                        {"faces", muscle.rest.F.rows()},
                        {"rest_volume_mm3", muscle.rest_volume_mm3},
                        {"rest_max_depth_mm", muscle.rest_penetration.max_depth_mm},
-                       {"max_abs_volume_error_percent", volume},
-                       {"max_depth_mm", depth},
-                       {"vertex_frames_deeper_than_tolerance", deeper},
-                       {"max_smoothness_change_percent", smooth},
-                       {"median_ms_per_frame", median(ms)},
+                       {"max_abs_volume_error_percent", summary.max_abs_volume_error_percent},
+                       {"max_depth_mm", summary.max_depth_mm},
+                       {"vertex_frames_deeper_than_tolerance", summary.vertex_frames_deeper},
+                       {"max_smoothness_change_percent", summary.max_smoothness_change_percent},
+                       {"median_ms_per_frame", summary.median_ms_per_frame},
                        {"setup_s", muscle.setup_seconds}});
   }
   return {{"frames", wrapped.times.size()},
           {"muscles", muscles},
           {"threads", wrapped.threads},
           {"seconds", wrapped.seconds},
-          {"median_ms_per_muscle_frame", median(all_ms)},
+          {"median_ms_per_muscle_frame", wrapping::median(all_ms)},
           {"max_abs_volume_error_percent", worst_volume},
           {"max_depth_mm", worst_depth},
           {"unconverged_muscle_frames", unconverged},
@@ -355,7 +289,8 @@ void WrapMuscles::run(workflow::NodeContext& context) {
   context.progress(2, 3, "writing the outputs");
   context.set_output("metrics", metrics_csv(wrapped));
   context.set_output("lines", lines_csv(wrapped));
-  context.set_output("plot", metrics_svg(wrapped));
+  context.set_output("plot", wrapping::wrapping_metrics_svg(
+                                 wrapped, "Muscle wrapping over the trial (energy pathway)"));
   context.set_output(
       "animation", animation_bundle(context, wrapped, atlas, atlas_dir, context.text("bone_level"),
                                     static_cast<int>(context.integer("animation_stride"))));

@@ -164,7 +164,7 @@ class MuscleWrapper {
     // The skeleton at rest is the atlas moved rigidly (every bone by the
     // root's rest pose, skeleton_from_atlas): the rest paths go back to the
     // atlas frame, where the surface is.
-    std::vector<LinePath> rest_lines = lines_at(pose, rest_q, -1);
+    std::vector<LinePath> rest_lines = lines_at(rest_q, -1);
     const Isometry3d to_atlas = rest_poses_.front().inverse();
     for (const Isometry3d& bone_pose : rest_poses_) {
       if (!(bone_pose.matrix() - rest_poses_.front().matrix()).isZero(1e-6)) {
@@ -226,8 +226,7 @@ class MuscleWrapper {
       const VectorXd q_stage = (1.0 - t) * previous_q_ + t * q;
       pose.set(q_stage);
       poses = bone_poses(pose, bones_);
-      const std::vector<LinePath> lines =
-          lines_at(pose, q_stage, stage == stages ? frame_index : -1);
+      const std::vector<LinePath> lines = lines_at(q_stage, stage == stages ? frame_index : -1);
       const MuscleBinding::Targets targets = binding_->targets(lines, poses);
       contacts = carried(contacts, previous_poses_, poses);
       ContactQuery query;
@@ -268,7 +267,7 @@ class MuscleWrapper {
  private:
   // The action lines in the pose; with frame >= 0 their paths, lengths and
   // moment arms are recorded for that frame.
-  std::vector<LinePath> lines_at(const motion::SkeletonPose& pose, const VectorXd& q, int frame) {
+  std::vector<LinePath> lines_at(const VectorXd& q, int frame) {
     std::vector<LinePath> lines;
     for (std::size_t l = 0; l < muscle_.action_lines.size(); ++l) {
       const atlas::ActionLine& line = muscle_.action_lines[l];
@@ -301,7 +300,6 @@ class MuscleWrapper {
                        : std::numeric_limits<double>::quiet_NaN();
       }
     }
-    static_cast<void>(pose);
     return lines;
   }
 
