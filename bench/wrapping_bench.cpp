@@ -20,6 +20,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
@@ -28,6 +29,8 @@
 
 #include <algorithm>
 #include "core/atlas/atlas_io.h"
+#include "core/mesh/io/mesh_io.h"
+#include "core/mesh/signed_distance.h"
 #include "core/motion/marker_mapping.h"
 #include "core/motion/motion_fusion.h"
 #include "core/motion/retarget.h"
@@ -36,6 +39,7 @@
 #include "core/opensim/trc.h"
 #include "core/plot/svg_plot.h"
 #include "core/wrapping/action_line_path.h"
+#include "core/wrapping/line_router.h"
 #include "core/wrapping/muscle_wrapping.h"
 #include "core/wrapping/osim_action_lines.h"
 #include "core/wrapping/wrapping_summary.h"
@@ -68,26 +72,63 @@ const Models& models() {
   return data;
 }
 
+std::filesystem::path atlas_dir() {
+  const char* dir = std::getenv("MMM_BENCH_ATLAS");
+  return dir != nullptr ? dir : "build/atlas/vhf_right_leg";
+}
+
+// Every bone of the default atlas with a mesh, as a signed distance (full
+// level) carried by its skeleton body: the obstacles of global paths.
+const std::vector<wrapping::RoutingBone>& atlas_routing_bones() {
+  static const std::vector<std::unique_ptr<mmm::mesh::SignedDistance>> surfaces = [] {
+    std::vector<std::unique_ptr<mmm::mesh::SignedDistance>> result;
+    for (const mmm::atlas::Bone& bone : models().atlas.bones) {
+      if (bone.meshes.empty() || !models().atlas_skeleton.body_index(bone.name)) continue;
+      const mmm::atlas::MeshLevel* level = &bone.meshes.front();
+      for (const mmm::atlas::MeshLevel& l : bone.meshes) {
+        if (l.level == "full") level = &l;
+      }
+      result.push_back(std::make_unique<mmm::mesh::SignedDistance>(
+          mmm::mesh::read_mesh(atlas_dir() / level->file)));
+    }
+    return result;
+  }();
+  static const std::vector<wrapping::RoutingBone> bones = [] {
+    std::vector<wrapping::RoutingBone> result;
+    std::size_t k = 0;
+    for (const mmm::atlas::Bone& bone : models().atlas.bones) {
+      const auto body = models().atlas_skeleton.body_index(bone.name);
+      if (bone.meshes.empty() || !body) continue;
+      result.push_back({surfaces[k++].get(), *body});
+    }
+    return result;
+  }();
+  return bones;
+}
+
 // Hip-flexion moment arm (mm) of one line at each angle (deg), everything
-// else at its default.
-std::vector<double> hip_flexion_arms(const mmm::atlas::Atlas& atlas,
-                                     const motion::Skeleton& skeleton,
-                                     const mmm::atlas::Muscle& muscle,
-                                     const mmm::atlas::ActionLine& line,
-                                     const std::vector<double>& angles) {
+// else at its default; the angles in order (a global path follows them).
+std::vector<double> hip_flexion_arms(
+    const mmm::atlas::Atlas& atlas, const motion::Skeleton& skeleton,
+    const mmm::atlas::Muscle& muscle, const mmm::atlas::ActionLine& line,
+    const std::vector<double>& angles,
+    wrapping::PathMethod method = wrapping::PathMethod::kObstacleSet) {
   const int hip = *skeleton.coordinate_index("hip_flexion_r");
+  wrapping::RouterOptions options;
+  options.method = method;
+  wrapping::LineRouter router(atlas, muscle, line, skeleton,
+                              method == wrapping::PathMethod::kGlobal
+                                  ? atlas_routing_bones()
+                                  : std::vector<wrapping::RoutingBone>{},
+                              options);
   std::vector<double> arms;
   for (const double angle : angles) {
     Eigen::VectorXd q = skeleton.default_coordinates();
     q(hip) = angle * kDeg;
-    arms.push_back(wrapping::moment_arm(atlas, muscle, line, skeleton, q, hip));
+    (void)router.route(q);
+    arms.push_back(router.moment_arm(q, hip));
   }
   return arms;
-}
-
-std::filesystem::path atlas_dir() {
-  const char* dir = std::getenv("MMM_BENCH_ATLAS");
-  return dir != nullptr ? dir : "build/atlas/vhf_right_leg";
 }
 
 // subject01's walk, 0.5-2.5 s, fitted to its OpenSim model and retargeted to
@@ -110,6 +151,70 @@ const motion::FusedMotion& atlas_walk() {
   return walk;
 }
 
+struct WalkSummary {
+  double max_volume_percent = 0.0;
+  double max_depth_mm = 0.0;
+  double max_bending_percent = 0.0;
+  int vertex_frames_deeper = 0;
+  double median_ms = 0.0;
+  double seconds = 0.0;
+};
+
+WalkSummary summarise_walk(const wrapping::MuscleWrapping& wrapped) {
+  WalkSummary walk;
+  std::vector<double> all_ms;
+  for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
+    const wrapping::MuscleWrappingSummary summary = wrapping::summarise(muscle);
+    walk.max_volume_percent =
+        std::max(walk.max_volume_percent, summary.max_abs_volume_error_percent);
+    walk.max_depth_mm = std::max(walk.max_depth_mm, summary.max_depth_mm);
+    walk.max_bending_percent =
+        std::max(walk.max_bending_percent, summary.max_smoothness_change_percent);
+    walk.vertex_frames_deeper += summary.vertex_frames_deeper;
+    all_ms.insert(all_ms.end(), summary.ms_per_frame.begin(), summary.ms_per_frame.end());
+  }
+  walk.median_ms = wrapping::median(all_ms);
+  walk.seconds = wrapped.seconds;
+  return walk;
+}
+
+// The whole walk with other options than the default, one summary line each.
+nlohmann::json write_variants_table(std::ostringstream& out, const WalkSummary& baseline) {
+  struct Variant {
+    std::string name;
+    wrapping::MuscleWrappingOptions options;
+  };
+  std::vector<Variant> variants(2);
+  variants[0].name = "direct (no hull)";
+  variants[0].options.coarse_to_fine = false;
+  variants[1].name = "global paths";
+  variants[1].options.routing.method = wrapping::PathMethod::kGlobal;
+  out << "\nvariants over the same walk\n"
+      << std::left << std::setw(26) << "variant" << std::setw(14) << "|vol err| %" << std::setw(12)
+      << "depth mm" << std::setw(14) << "max bending %" << std::setw(12) << "median ms"
+      << "whole walk s\n";
+  nlohmann::json rows = nlohmann::json::array();
+  const auto row = [&](const std::string& name, const WalkSummary& walk) {
+    out << std::setw(26) << name << std::setw(14) << std::scientific << std::setprecision(1)
+        << walk.max_volume_percent << std::fixed << std::setw(12) << std::setprecision(2)
+        << walk.max_depth_mm << std::setw(14) << std::setprecision(0) << walk.max_bending_percent
+        << std::setw(12) << std::setprecision(1) << walk.median_ms << walk.seconds << "\n";
+    rows.push_back({{"variant", name},
+                    {"max_abs_volume_error_percent", walk.max_volume_percent},
+                    {"max_depth_mm", walk.max_depth_mm},
+                    {"max_bending_change_percent", walk.max_bending_percent},
+                    {"vertex_frames_deeper_than_tolerance", walk.vertex_frames_deeper},
+                    {"median_ms_per_muscle_frame", walk.median_ms},
+                    {"whole_walk_s", walk.seconds}});
+  };
+  row("coarse to fine (default)", baseline);
+  for (const Variant& variant : variants) {
+    row(variant.name, summarise_walk(wrapping::wrap_muscles(models().atlas, atlas_dir(),
+                                                            atlas_walk(), variant.options)));
+  }
+  return rows;
+}
+
 nlohmann::json write_trial_table(std::ostringstream& out) {
   const mmm::wrapping::MuscleWrappingOptions options;
   const wrapping::MuscleWrapping wrapped =
@@ -120,8 +225,8 @@ nlohmann::json write_trial_table(std::ostringstream& out) {
       << " threads\n"
       << std::left << std::setw(30) << "muscle" << std::setw(8) << "faces" << std::setw(14)
       << "|vol err| %" << std::setw(12) << "depth mm" << std::setw(12) << "bending %"
-      << std::setw(12) << "median ms"
-      << "setup s\n";
+      << std::setw(12) << "median ms" << std::setw(10) << "setup s"
+      << "hull faces / build s / outside\n";
   nlohmann::json rows = nlohmann::json::array();
   std::vector<double> all_ms;
   std::vector<double> ten_k_ms;
@@ -142,15 +247,19 @@ nlohmann::json write_trial_table(std::ostringstream& out) {
     out << std::setw(30) << muscle.name << std::setw(8) << muscle.rest.F.rows() << std::setw(14)
         << std::scientific << std::setprecision(1) << volume << std::fixed << std::setw(12)
         << std::setprecision(2) << depth << std::setw(12) << std::setprecision(0) << bending
-        << std::setw(12) << std::setprecision(1) << wrapping::median(ms) << std::setprecision(2)
-        << muscle.setup_seconds << "\n";
+        << std::setw(12) << std::setprecision(1) << wrapping::median(ms) << std::setw(10)
+        << std::setprecision(2) << muscle.setup_seconds << muscle.hull_faces << " / "
+        << muscle.hull_build_seconds << " / " << muscle.hull_vertices_outside << "\n";
     rows.push_back({{"muscle", muscle.name},
                     {"faces", muscle.rest.F.rows()},
                     {"max_abs_volume_error_percent", volume},
                     {"max_depth_mm", depth},
                     {"max_bending_change_percent", bending},
                     {"median_ms_per_frame", wrapping::median(ms)},
-                    {"setup_s", muscle.setup_seconds}});
+                    {"setup_s", muscle.setup_seconds},
+                    {"hull_faces", muscle.hull_faces},
+                    {"hull_build_s", muscle.hull_build_seconds},
+                    {"hull_vertices_outside", muscle.hull_vertices_outside}});
   }
   out << std::setprecision(3) << "all: max |volume error| " << std::scientific << worst_volume
       << std::fixed
@@ -171,7 +280,9 @@ nlohmann::json write_trial_table(std::ostringstream& out) {
       wrapping::wrapping_metrics_svg(wrapped,
                                      "Muscle wrapping over subject01's walk on the default atlas"),
       std::filesystem::path(out_dir != nullptr ? out_dir : ".") / "wrapping_metrics.svg");
+  const nlohmann::json variants = write_variants_table(out, summarise_walk(wrapped));
   return {{"muscles", rows},
+          {"variants", variants},
           {"frames", wrapped.times.size()},
           {"threads", wrapped.threads},
           {"whole_walk_s", wrapped.seconds},
@@ -198,39 +309,54 @@ void write_accuracy_table() {
   std::ostringstream out;
   out << "\nhip-flexion moment arms (mm, + flexor): default atlas (VHF bones) vs the gait2392 "
          "model, hip flexion -20..60 deg, other joints at 0\n"
-      << std::left << std::setw(16) << "action line" << std::setw(20) << "atlas at -20/20/60"
-      << std::setw(20) << "gait2392 -20/20/60"
-      << "RMS difference\n";
+      << std::left << std::setw(16) << "action line" << std::setw(20) << "gait2392 -20/20/60"
+      << std::setw(20) << "obstacle set" << std::setw(20) << "global (bones)"
+      << "RMS difference obstacle set / global\n";
   nlohmann::json rows = nlohmann::json::array();
+  std::vector<double> obstacle_rms;
+  std::vector<double> global_rms_all;
   for (const mmm::atlas::Muscle& muscle : m.atlas.muscles) {
     for (const mmm::atlas::ActionLine& line : muscle.action_lines) {
       const mmm::atlas::Muscle* theirs = m.gait2392.find_muscle(line.name);
       if (theirs == nullptr) continue;
       const std::vector<double> ours =
           hip_flexion_arms(m.atlas, m.atlas_skeleton, muscle, line, angles);
+      const std::vector<double> global = hip_flexion_arms(m.atlas, m.atlas_skeleton, muscle, line,
+                                                          angles, wrapping::PathMethod::kGlobal);
       const std::vector<double> reference = hip_flexion_arms(
           m.gait2392, m.gait2392_skeleton, *theirs, theirs->action_lines.front(), angles);
-      double squares = 0;
-      for (std::size_t i = 0; i < angles.size(); ++i) {
-        squares += (ours[i] - reference[i]) * (ours[i] - reference[i]);
-      }
-      const double rms = std::sqrt(squares / static_cast<double>(angles.size()));
+      const auto rms_from_reference = [&](const std::vector<double>& arms) {
+        double squares = 0;
+        for (std::size_t i = 0; i < angles.size(); ++i)
+          squares += (arms[i] - reference[i]) * (arms[i] - reference[i]);
+        return std::sqrt(squares / static_cast<double>(angles.size()));
+      };
+      const double rms = rms_from_reference(ours);
+      const double global_rms = rms_from_reference(global);
       if (std::abs(reference[4]) < 5.0 && std::abs(ours[4]) < 5.0) continue;  // not a hip muscle
       const auto triple = [](const std::vector<double>& v) {
         std::ostringstream t;
         t << std::fixed << std::setprecision(0) << v[0] << "/" << v[4] << "/" << v[8];
         return t.str();
       };
-      out << std::setw(16) << line.name << std::setw(20) << triple(ours) << std::setw(20)
-          << triple(reference) << std::fixed << std::setprecision(1) << rms << "\n";
+      out << std::setw(16) << line.name << std::setw(20) << triple(reference) << std::setw(20)
+          << triple(ours) << std::setw(20) << triple(global) << std::fixed << std::setprecision(1)
+          << rms << " / " << global_rms << "\n";
+      obstacle_rms.push_back(rms);
+      global_rms_all.push_back(global_rms);
       rows.push_back({{"action_line", line.name},
                       {"muscle", muscle.name},
                       {"angles_deg", angles},
                       {"atlas_mm", ours},
                       {"gait2392_mm", reference},
-                      {"rms_mm", rms}});
+                      {"rms_mm", rms},
+                      {"global_mm", global},
+                      {"global_rms_mm", global_rms}});
     }
   }
+  out << std::setprecision(1) << "median RMS difference: obstacle set "
+      << wrapping::median(obstacle_rms) << " mm, global " << wrapping::median(global_rms_all)
+      << " mm (" << obstacle_rms.size() << " hip lines)\n";
   std::cout << out.str();
   const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
   const std::filesystem::path folder = out_dir != nullptr ? out_dir : ".";

@@ -1,5 +1,6 @@
 #include "nodes/registry.h"
 
+#include "nodes/build_hulls.h"
 #include "nodes/decimate_mesh.h"
 #include "nodes/fuse_motion.h"
 #include "nodes/import_markups.h"
@@ -26,6 +27,7 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<StaticTrialLandmarks>();
   registry.add<ScaleAtlas>();
   registry.add<FuseMotion>();
+  registry.add<BuildHulls>();
   registry.add<WrapMuscles>();
   return registry;
 }

@@ -16,21 +16,10 @@
 #include "core/motion/motion_io.h"
 #include "core/wrapping/muscle_wrapping.h"
 #include "core/wrapping/wrapping_summary.h"
+#include "nodes/name_list.h"
 
 namespace mmm::nodes {
 namespace {
-
-std::vector<std::string> split_names(const std::string& text) {
-  std::vector<std::string> names;
-  std::stringstream stream(text);
-  std::string name;
-  while (std::getline(stream, name, ',')) {
-    name.erase(0, name.find_first_not_of(" \t"));
-    name.erase(name.find_last_not_of(" \t") + 1);
-    if (!name.empty()) names.push_back(name);
-  }
-  return names;
-}
 
 wrapping::MuscleWrappingOptions options_from(const workflow::NodeContext& context) {
   wrapping::MuscleWrappingOptions options;
@@ -41,6 +30,12 @@ wrapping::MuscleWrappingOptions options_from(const workflow::NodeContext& contex
       static_cast<int>(context.integer("first_frame_intermediate_poses"));
   options.muscles = split_names(context.text("muscles"));
   options.threads = static_cast<int>(context.integer("threads"));
+  options.coarse_to_fine = context.flag("coarse_to_fine");
+  options.routing.method = context.text("path_method") == "global"
+                               ? wrapping::PathMethod::kGlobal
+                               : wrapping::PathMethod::kObstacleSet;
+  options.routing.global.clearance_mm = context.number("path_clearance_mm");
+  options.hull_faces = context.integer("hull_faces");
   options.deformer.stiffness_length_mm = context.number("stiffness_length_mm");
   options.contacts.tolerance_mm = context.number("contact_tolerance_mm");
   options.contacts.clearance_mm = context.number("contact_clearance_mm");
@@ -57,7 +52,8 @@ std::string metrics_csv(const wrapping::MuscleWrapping& wrapped) {
   std::string csv =
       "muscle,frame,time_s,volume_error_percent,max_depth_mm,vertices_inside,vertices_deeper,"
       "deepest_bone,"
-      "smoothness_change_percent,contacts,contact_rounds,volume_iterations,converged,ms\n";
+      "smoothness_change_percent,contacts,hull_contacts,path_contacts,contact_rounds,volume_"
+      "iterations,converged,ms\n";
   for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
     for (std::size_t f = 0; f < muscle.frames.size(); ++f) {
       const wrapping::MuscleFrameMetrics& m = muscle.frames[f];
@@ -66,7 +62,8 @@ std::string metrics_csv(const wrapping::MuscleWrapping& wrapped) {
              fixed(m.volume_error_percent, 8) + "," + fixed(m.max_depth_mm, 3) + "," +
              std::to_string(m.vertices_inside) + "," + std::to_string(m.vertices_deeper) + "," +
              m.deepest_bone + "," + fixed(m.smoothness_change_percent, 2) + "," +
-             std::to_string(m.contacts) + "," + std::to_string(m.contact_rounds) + "," +
+             std::to_string(m.contacts) + "," + std::to_string(m.hull_contacts) + "," +
+             std::to_string(m.path_contacts) + "," + std::to_string(m.contact_rounds) + "," +
              std::to_string(m.volume_iterations) + "," + (m.converged ? "1" : "0") + "," +
              fixed(1000.0 * m.seconds, 2) + "\n";
     }
@@ -118,7 +115,15 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
                        {"vertex_frames_deeper_than_tolerance", summary.vertex_frames_deeper},
                        {"max_smoothness_change_percent", summary.max_smoothness_change_percent},
                        {"median_ms_per_frame", summary.median_ms_per_frame},
-                       {"setup_s", muscle.setup_seconds}});
+                       {"setup_s", muscle.setup_seconds},
+                       {"hull",
+                        {{"faces", muscle.hull_faces},
+                         {"reused", muscle.hull_reused},
+                         {"build_s", muscle.hull_build_seconds},
+                         {"volume_mm3", muscle.hull_volume_mm3},
+                         {"vertices_outside", muscle.hull_vertices_outside},
+                         {"max_outside_mm", muscle.hull_max_outside_mm},
+                         {"max_depth_of_surface_inside_mm", muscle.hull_max_offset_mm}}}});
   }
   return {{"frames", wrapped.times.size()},
           {"muscles", muscles},
@@ -136,6 +141,11 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
            {{"target_faces", options.target_faces},
             {"bone_contacts", options.bone_contacts},
             {"intermediate_poses", options.intermediate_poses},
+            {"coarse_to_fine", options.coarse_to_fine},
+            {"path_method",
+             options.routing.method == wrapping::PathMethod::kGlobal ? "global" : "obstacle_set"},
+            {"path_clearance_mm", options.routing.global.clearance_mm},
+            {"hull_faces", options.hull_faces},
             {"first_frame_intermediate_poses", options.first_frame_intermediate_poses},
             {"stiffness_length_mm", options.deformer.stiffness_length_mm},
             {"contact_tolerance_mm", options.contacts.tolerance_mm},
@@ -211,6 +221,9 @@ workflow::NodeSpec WrapMuscles::spec() {
                             "keeping it out of the bones"}
       .input<Atlas>("atlas", "The (scaled) atlas the motion drives")
       .input<BonePoses>("motion", "Fused motion of this atlas (fuse_motion with the atlas input)")
+      .optional_input<File>("hulls",
+                            "Stored progressive hulls (build_hulls); a muscle whose hull is "
+                            "missing or was built from another surface gets a new one")
       .param<std::int64_t>(
           "target_faces", d.target_faces,
           "Wrapping resolution: each muscle's full mesh decimated to this many faces "
@@ -218,6 +231,16 @@ workflow::NodeSpec WrapMuscles::spec() {
           {.min = 0, .max = 1000000})
       .param<bool>("bone_contacts", d.bone_contacts,
                    "Keep the muscles out of the bones (impenetrability)")
+      .param_enum("path_method", "obstacle_set", {"obstacle_set", "global"},
+                  "Action-line paths: straight between the path points and wrapped over the "
+                  "atlas's fitted obstacles, or the shortest path keeping clear of the bone "
+                  "meshes themselves (Ceres)")
+      .param<double>("path_clearance_mm", d.routing.global.clearance_mm,
+                     "Global paths keep this distance from every bone", {.min = 0, .max = 20}, "mm")
+      .param<bool>("coarse_to_fine", d.coarse_to_fine,
+                   "Solve each muscle's progressive hull first, then its surface from there")
+      .param<std::int64_t>("hull_faces", d.hull_faces, "Faces of the progressive hulls",
+                           {.min = 4, .max = 1000000})
       .param<std::int64_t>("intermediate_poses", d.intermediate_poses,
                            "Interpolated variant: poses solved between consecutive frames first",
                            {.min = 0, .max = 50})
@@ -275,14 +298,28 @@ void WrapMuscles::run(workflow::NodeContext& context) {
         "wrap_muscles: input 'motion' drives an OpenSim model, not an atlas; hint: give "
         "fuse_motion the atlas input (and the model to retarget from)");
   }
-  const wrapping::MuscleWrappingOptions options = options_from(context);
+  wrapping::MuscleWrappingOptions options = options_from(context);
+  if (context.has_input("hulls")) {
+    const std::filesystem::path hulls_dir = context.scratch_dir() / "hulls";
+    unpack_directory(context.input_bytes("hulls"), hulls_dir, "input 'hulls'");
+    options.hulls = wrapping::read_hulls(hulls_dir);
+  }
   context.progress(
       1, 3,
       "wrapping " +
           std::to_string(options.muscles.empty() ? atlas.muscles.size() : options.muscles.size()) +
           " muscles over " + std::to_string(fused.num_frames()) + " frames");
   const wrapping::MuscleWrapping wrapped = wrapping::wrap_muscles(atlas, atlas_dir, fused, options);
+  int hulls_built = 0;
+  for (const wrapping::WrappedMuscle& muscle : wrapped.muscles)
+    hulls_built += muscle.hull_faces > 0 && !muscle.hull_reused ? 1 : 0;
+  if (options.coarse_to_fine && context.has_input("hulls") && hulls_built > 0) {
+    context.warn(std::to_string(hulls_built) +
+                 " hulls were built here: the stored ones were built from other surfaces or "
+                 "face counts; hint: give build_hulls the same atlas, target_faces and hull_faces");
+  }
   nlohmann::json report = report_of(wrapped, options);
+  report["hulls_built_here"] = hulls_built;
   context.info("wrapped in " + fixed(wrapped.seconds, 1) + " s: max volume error " +
                fixed(report["max_abs_volume_error_percent"].get<double>(), 6) + " %, max depth " +
                fixed(report["max_depth_mm"].get<double>(), 2) + " mm");

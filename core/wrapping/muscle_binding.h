@@ -89,6 +89,9 @@ class MuscleBinding {
                                 const std::vector<Eigen::Isometry3d>& poses) const;
 
   [[nodiscard]] Eigen::Index num_vertices() const { return rest_.rows(); }
+  // Per vertex: 1 where it moves with its attachment bone, 0 where with the
+  // lines, smoothly between (the blend above).
+  [[nodiscard]] const Eigen::VectorXd& bone_blend() const { return bone_blend_; }
 
  private:
   struct LineBinding {

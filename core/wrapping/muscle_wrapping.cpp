@@ -9,16 +9,17 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
 #include <utility>
 
 #include "core/errors.h"
-#include "core/mesh/decimate.h"
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/laplacian.h"
 #include "core/motion/skeleton.h"
+#include "core/wrapping/hull_embedding.h"
 
 namespace mmm::wrapping {
 namespace {
@@ -136,6 +137,56 @@ std::vector<Contact> carried(const std::vector<Contact>& contacts,
   return result;
 }
 
+// One resolution of a muscle (its wrapping surface, or its hull): binding,
+// factored energy, bone contacts, and the contacts carried between solves.
+struct Level {
+  std::unique_ptr<BoneContacts> contacts;
+  std::unique_ptr<MuscleBinding> binding;
+  std::unique_ptr<VolumeDeformer> deformer;
+  std::vector<Contact> carried;
+};
+
+Level make_level(const mesh::IndexedMesh& surface, const std::vector<LinePath>& rest_lines,
+                 const std::set<int>& attachment_bones, const PosedBones& bones,
+                 const MuscleWrappingOptions& options) {
+  Level level;
+  level.contacts = std::make_unique<BoneContacts>(surface.V, bones.surfaces, options.contacts);
+  std::vector<AttachmentBone> attachments;
+  attachments.reserve(attachment_bones.size());
+  for (const int b : attachment_bones) {
+    attachments.push_back(
+        {b, level.contacts->rest_distance(static_cast<std::size_t>(b)).cwiseMax(0.0)});
+  }
+  level.binding = std::make_unique<MuscleBinding>(surface.V, surface.F, rest_lines,
+                                                  std::move(attachments), options.binding);
+  level.deformer = std::make_unique<VolumeDeformer>(surface, options.deformer);
+  return level;
+}
+
+// Where the hull carries the surface, except near the attachments, which
+// follow their bones as the binding has them.
+MuscleBinding::Targets blend_with_hull(const MuscleBinding::Targets& own,
+                                       const HullEmbedding::Transfer& from_hull,
+                                       const Eigen::VectorXd& bone_blend) {
+  MuscleBinding::Targets targets;
+  targets.positions.resize(own.positions.rows(), 3);
+  targets.rotations.resize(own.rotations.size());
+  for (Eigen::Index i = 0; i < own.positions.rows(); ++i) {
+    const double beta = bone_blend[i];
+    const auto k = static_cast<std::size_t>(i);
+    targets.positions.row(i) =
+        beta * own.positions.row(i) + (1.0 - beta) * from_hull.positions.row(i);
+    if (beta <= 0.0) {
+      targets.rotations[k] = from_hull.rotations[k];
+    } else {
+      const Eigen::Quaterniond hull_turn(from_hull.rotations[k]);
+      const Eigen::Quaterniond own_turn(own.rotations[k]);
+      targets.rotations[k] = hull_turn.slerp(beta, own_turn).toRotationMatrix();
+    }
+  }
+  return targets;
+}
+
 class MuscleWrapper {
  public:
   MuscleWrapper(const atlas::Atlas& atlas, const atlas::Muscle& muscle,
@@ -148,12 +199,7 @@ class MuscleWrapper {
       throw InvalidInputError("muscle wrapping: muscle '" + muscle.name + "' has no action line");
     }
     result_.name = muscle.name;
-    mesh::IndexedMesh surface = mesh::read_mesh(dir / full_level(muscle.meshes, muscle.name).file);
-    if (options.target_faces > 0 && surface.F.rows() > options.target_faces) {
-      mesh::DecimateOptions decimate;
-      decimate.target_faces = options.target_faces;
-      surface = mesh::decimate(surface, decimate);
-    }
+    const mesh::IndexedMesh surface = wrapping_surface(muscle, dir, options.target_faces);
     result_.rest = surface;
     laplacian_ = mesh::cotangent_laplacian(surface.V, surface.F);
     rest_bending_ = bending(laplacian_, surface.V);
@@ -164,6 +210,13 @@ class MuscleWrapper {
     // The skeleton at rest is the atlas moved rigidly (every bone by the
     // root's rest pose, skeleton_from_atlas): the rest paths go back to the
     // atlas frame, where the surface is.
+    std::vector<RoutingBone> routing_bones;
+    if (options.routing.method == PathMethod::kGlobal) {
+      for (std::size_t b = 0; b < bones.names.size(); ++b)
+        routing_bones.push_back({bones.surfaces[b].surface.get(), bones.bodies[b]});
+    }
+    for (const atlas::ActionLine& line : muscle.action_lines)
+      routers_.emplace_back(atlas, muscle, line, skeleton, routing_bones, options.routing);
     std::vector<LinePath> rest_lines = lines_at(rest_q, -1);
     const Isometry3d to_atlas = rest_poses_.front().inverse();
     for (const Isometry3d& bone_pose : rest_poses_) {
@@ -181,7 +234,6 @@ class MuscleWrapper {
     for (const atlas::ActionLine& line : muscle.action_lines)
       result_.lines.push_back({line.name, {}, {}, {}});
 
-    contacts_ = std::make_unique<BoneContacts>(surface.V, bones.surfaces, options.contacts);
     std::set<int> attachment_bones;
     for (const auto* areas : {&muscle.origins, &muscle.insertions}) {
       for (const atlas::AttachmentArea& area : *areas) {
@@ -194,17 +246,25 @@ class MuscleWrapper {
       attachment_bones.insert(line.origin_pose_index);
       attachment_bones.insert(line.insertion_pose_index);
     }
-    std::vector<AttachmentBone> attachments;
-    attachments.reserve(attachment_bones.size());
-    for (const int b : attachment_bones) {
-      attachments.push_back(
-          {b, contacts_->rest_distance(static_cast<std::size_t>(b)).cwiseMax(0.0)});
+    fine_ = make_level(surface, rest_lines, attachment_bones, bones, options);
+    if (options.coarse_to_fine) {
+      const std::string source_hash = mesh_hash(surface);
+      const MuscleHull* stored =
+          find_hull(options.hulls, muscle.name, source_hash, options.hull_faces);
+      const MuscleHull hull =
+          stored != nullptr ? *stored : build_muscle_hull(muscle.name, surface, options.hull_faces);
+      result_.hull_reused = stored != nullptr;
+      result_.hull_build_seconds = stored != nullptr ? 0.0 : hull.seconds;
+      result_.hull_faces = hull.hull.F.rows();
+      result_.hull_vertices_outside = hull.report.vertices_outside;
+      result_.hull_max_outside_mm = hull.report.max_outside_mm;
+      coarse_ = make_level(hull.hull, rest_lines, attachment_bones, bones, options);
+      result_.hull_volume_mm3 = coarse_->deformer->rest_volume();
+      embedding_ = std::make_unique<HullEmbedding>(hull.hull, surface.V);
+      result_.hull_max_offset_mm = embedding_->max_offset();
     }
-    binding_ = std::make_unique<MuscleBinding>(surface.V, surface.F, rest_lines,
-                                               std::move(attachments), options.binding);
-    deformer_ = std::make_unique<VolumeDeformer>(surface, options.deformer);
-    result_.rest_volume_mm3 = deformer_->rest_volume();
-    result_.rest_penetration = contacts_->measure(
+    result_.rest_volume_mm3 = fine_.deformer->rest_volume();
+    result_.rest_penetration = fine_.contacts->measure(
         surface.V, std::vector<Isometry3d>(bones.names.size(), Isometry3d::Identity()));
     previous_q_ = rest_q;
     previous_poses_ = rest_poses_;
@@ -215,8 +275,8 @@ class MuscleWrapper {
     const Clock::time_point start = Clock::now();
     motion::SkeletonPose pose(skeleton_);
     const int frame_index = static_cast<int>(result_.frames.size());
-    std::vector<Contact> contacts = contacts_carried_;
     DeformResult solved;
+    DeformResult hull_solved;
     std::vector<Isometry3d> poses;
     const int stages =
         (frame_index == 0 ? options_.first_frame_intermediate_poses : options_.intermediate_poses) +
@@ -227,26 +287,21 @@ class MuscleWrapper {
       pose.set(q_stage);
       poses = bone_poses(pose, bones_);
       const std::vector<LinePath> lines = lines_at(q_stage, stage == stages ? frame_index : -1);
-      const MuscleBinding::Targets targets = binding_->targets(lines, poses);
-      contacts = carried(contacts, previous_poses_, poses);
-      ContactQuery query;
-      if (options_.bone_contacts) {
-        query = [&](const MatrixX3d& x, const std::vector<char>& active) {
-          return contacts_->find(x, poses, active);
-        };
-      } else {
-        contacts.clear();
+      MuscleBinding::Targets targets = fine_.binding->targets(lines, poses);
+      if (coarse_) {
+        const MuscleBinding::Targets hull_targets = coarse_->binding->targets(lines, poses);
+        hull_solved = solve(*coarse_, hull_targets, poses);
+        targets = blend_with_hull(targets, embedding_->transfer(hull_solved.x),
+                                  fine_.binding->bone_blend());
       }
-      solved = deformer_->solve(targets.positions, targets.rotations, contacts, query);
-      contacts = solved.contacts;
+      solved = solve(fine_, targets, poses);
       previous_poses_ = poses;
     }
-    contacts_carried_ = contacts;
     previous_q_ = q;
 
     MuscleFrameMetrics metrics;
     metrics.volume_error_percent = 100.0 * solved.volume_error;
-    const PenetrationMetrics penetration = contacts_->measure(solved.x, poses);
+    const PenetrationMetrics penetration = fine_.contacts->measure(solved.x, poses);
     metrics.max_depth_mm = penetration.max_depth_mm;
     metrics.vertices_inside = penetration.vertices_inside;
     metrics.vertices_deeper = penetration.vertices_deeper;
@@ -254,9 +309,11 @@ class MuscleWrapper {
     metrics.smoothness_change_percent =
         100.0 * (bending(laplacian_, solved.x) / rest_bending_ - 1.0);
     metrics.contacts = static_cast<int>(solved.contacts.size());
+    metrics.hull_contacts = static_cast<int>(hull_solved.contacts.size());
+    metrics.path_contacts = path_contacts_;
     metrics.contact_rounds = solved.contact_rounds;
     metrics.volume_iterations = solved.volume_iterations;
-    metrics.converged = solved.converged;
+    metrics.converged = solved.converged && hull_solved.converged;
     result_.positions.emplace_back(solved.x.cast<float>());
     metrics.seconds = seconds_since(start);
     result_.frames.push_back(metrics);
@@ -269,10 +326,12 @@ class MuscleWrapper {
   // moment arms are recorded for that frame.
   std::vector<LinePath> lines_at(const VectorXd& q, int frame) {
     std::vector<LinePath> lines;
+    path_contacts_ = 0;
     for (std::size_t l = 0; l < muscle_.action_lines.size(); ++l) {
       const atlas::ActionLine& line = muscle_.action_lines[l];
-      const ActionLinePath path =
-          action_line_path(atlas_, muscle_, line, skeleton_, q, options_.path);
+      LineRouter& router = routers_[l];
+      const ActionLinePath path = router.route(q);
+      path_contacts_ += router.last_contacts();
       LinePath posed;
       posed.points = path.points;
       posed.origin_pose_index =
@@ -295,12 +354,30 @@ class MuscleWrapper {
       for (Eigen::Index c = 0; c < arms; ++c) {
         const auto coordinate = skeleton_.coordinate_index(
             options_.moment_arm_coordinates[static_cast<std::size_t>(c)]);
-        record.moment_arms_mm(frame, c) =
-            coordinate ? moment_arm(atlas_, muscle_, line, skeleton_, q, *coordinate, options_.path)
-                       : std::numeric_limits<double>::quiet_NaN();
+        record.moment_arms_mm(frame, c) = coordinate ? router.moment_arm(q, *coordinate)
+                                                     : std::numeric_limits<double>::quiet_NaN();
       }
     }
     return lines;
+  }
+
+  // One volume-constrained solve of a level in this stage's bone poses, its
+  // contacts carried from the previous stage and found inside the solve.
+  DeformResult solve(Level& level, const MuscleBinding::Targets& targets,
+                     const std::vector<Isometry3d>& poses) {
+    std::vector<Contact> contacts = carried(level.carried, previous_poses_, poses);
+    ContactQuery query;
+    if (options_.bone_contacts) {
+      query = [&](const MatrixX3d& x, const std::vector<char>& active) {
+        return level.contacts->find(x, poses, active);
+      };
+    } else {
+      contacts.clear();
+    }
+    DeformResult solved =
+        level.deformer->solve(targets.positions, targets.rotations, std::move(contacts), query);
+    level.carried = solved.contacts;
+    return solved;
   }
 
   const atlas::Atlas& atlas_;
@@ -314,10 +391,11 @@ class MuscleWrapper {
   std::vector<Isometry3d> rest_poses_;
   std::vector<Isometry3d> previous_poses_;
   VectorXd previous_q_;
-  std::vector<Contact> contacts_carried_;
-  std::unique_ptr<BoneContacts> contacts_;
-  std::unique_ptr<MuscleBinding> binding_;
-  std::unique_ptr<VolumeDeformer> deformer_;
+  std::vector<LineRouter> routers_;  // per action line
+  int path_contacts_ = 0;            // of the last lines_at
+  Level fine_;
+  std::optional<Level> coarse_;  // coarse to fine: the hull
+  std::unique_ptr<HullEmbedding> embedding_;
 };
 
 std::vector<const atlas::Muscle*> selected_muscles(const atlas::Atlas& atlas,
@@ -345,6 +423,8 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
   if (motion.num_frames() == 0) throw InvalidInputError("muscle wrapping: the motion has no frame");
   if (options.intermediate_poses < 0)
     throw InvalidInputError("muscle wrapping: intermediate_poses must be >= 0");
+  if (options.coarse_to_fine && options.hull_faces < 4)
+    throw InvalidInputError("muscle wrapping: hull_faces must be >= 4 (a tetrahedron)");
   const std::vector<const atlas::Muscle*> muscles = selected_muscles(atlas, options.muscles);
   const motion::Skeleton skeleton = motion::skeleton_from_atlas(atlas);
   const VectorXd rest_q = rest_coordinates(atlas, skeleton);

@@ -27,7 +27,9 @@
 #include "core/motion/motion_fusion.h"
 #include "core/wrapping/action_line_path.h"
 #include "core/wrapping/bone_contacts.h"
+#include "core/wrapping/line_router.h"
 #include "core/wrapping/muscle_binding.h"
+#include "core/wrapping/muscle_hulls.h"
 #include "core/wrapping/volume_deformer.h"
 
 namespace mmm::wrapping {
@@ -41,13 +43,25 @@ struct MuscleWrappingOptions {
   // others (folds); in small steps it is pushed out where it enters.
   int first_frame_intermediate_poses = 8;  // >= 0
   std::vector<std::string> muscles;        // empty: every muscle of the atlas
+  // Coarse to fine (section 3.4.2): per pose the muscle's progressive hull
+  // (hull_faces) is solved first, with its own volume and bone contacts;
+  // the surface then starts from where the hull carries it (hull_embedding.h),
+  // blended into its attachment bones' motion, and is solved with its own
+  // contacts and exact volume. false: the surface is solved directly.
+  bool coarse_to_fine = true;
+  Eigen::Index hull_faces = 1000;
+  // Stored hulls (muscle_hulls.h): one whose source hash matches the
+  // wrapping surface and whose face count matches hull_faces is reused,
+  // else the hull is built.
+  std::vector<MuscleHull> hulls;
   std::vector<std::string> moment_arm_coordinates = {"hip_flexion_r", "hip_adduction_r",
                                                      "hip_rotation_r", "knee_angle_r"};
   int threads = 0;  // 0: the hardware's
   DeformerOptions deformer;
   BindingOptions binding;
   ContactOptions contacts;
-  PathOptions path;
+  // Action-line paths: obstacle set (default) or global (bone meshes).
+  RouterOptions routing;
 };
 
 struct MuscleFrameMetrics {
@@ -58,6 +72,8 @@ struct MuscleFrameMetrics {
   std::string deepest_bone;
   double smoothness_change_percent = 0.0;  // bending energy sum |L x|^2 vs rest
   int contacts = 0;
+  int path_contacts = 0;  // global paths: segments resting on a bone
+  int hull_contacts = 0;  // coarse to fine: contacts of the hull's solve
   int contact_rounds = 0;
   int volume_iterations = 0;
   bool converged = true;
@@ -77,7 +93,17 @@ struct WrappedMuscle {
   std::vector<Eigen::MatrixX3f> positions;  // per frame (mm)
   std::vector<MuscleFrameMetrics> frames;
   std::vector<WrappedLine> lines;
-  double setup_seconds = 0.0;  // decimation, binding, factorisation, rest distances
+  double setup_seconds = 0.0;  // decimation, hull, binding, factorisation, rest distances
+  // Coarse to fine: the hull's faces (0: solved directly), whether a stored
+  // hull was reused, its containment check and volume, its build time (0
+  // when reused) and the largest distance of the surface inside it.
+  Eigen::Index hull_faces = 0;
+  bool hull_reused = false;
+  int hull_vertices_outside = 0;
+  double hull_max_outside_mm = 0.0;
+  double hull_volume_mm3 = 0.0;
+  double hull_build_seconds = 0.0;
+  double hull_max_offset_mm = 0.0;
   double rest_volume_mm3 = 0.0;
   PenetrationMetrics rest_penetration;  // of the rest surface in the rest pose
 };

@@ -104,12 +104,12 @@ TEST(WorkflowCliTest, NodesJsonIsMachineReadable) {
     names.push_back(type["name"].get<std::string>());
     EXPECT_EQ(type["manual"].get<bool>(), type["name"] == "landmark_station") << type["name"];
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"decimate_mesh", "fuse_motion", "import_markups",
-                                             "landmark_report", "landmark_station", "load_mesh",
-                                             "load_radiographs", "measure_mesh", "scale_atlas",
-                                             "static_trial_landmarks", "wrap_muscles"}))
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "build_hulls", "decimate_mesh", "fuse_motion", "import_markups",
+                       "landmark_report", "landmark_station", "load_mesh", "load_radiographs",
+                       "measure_mesh", "scale_atlas", "static_trial_landmarks", "wrap_muscles"}))
       << "sorted by name";
-  const auto& decimate = json["node_types"][0];
+  const auto& decimate = json["node_types"][1];
   EXPECT_EQ(decimate["name"], "decimate_mesh");
   EXPECT_EQ(decimate["inputs"][0]["type"], "Mesh");
   EXPECT_EQ(decimate["params"][0]["name"], "target_faces");

@@ -14,6 +14,7 @@
 #include "core/directory_bundle.h"
 #include "core/errors.h"
 #include "core/mesh/io/pvd.h"
+#include "nodes/build_hulls.h"
 #include "nodes/fuse_motion.h"
 #include "tests/nodes/node_harness.h"
 #include "tests/support/test_data.h"
@@ -26,24 +27,39 @@ using workflow::PortType;
 
 std::filesystem::path pipelines() { return mmm::test::data_dir() / "gait2392" / "Pipelines"; }
 
-TEST(WrapMusclesNodeTest, WrapsTheToyLegsMuscleOverARetargetedWalk) {
-  test::NodeHarness harness;
-  mmm::test::ToyLeg leg = mmm::test::toy_leg();
-  // Three pelvis markers, as retargeting measures the patient against the trial.
+// The toy leg with three pelvis markers (retargeting measures the patient
+// against the trial), written into the harness, and its motion over the
+// walk from 0.5 s to end_time.
+struct ToyLegAndWalk {
+  mmm::test::ToyLeg leg;
+  workflow::ArtifactRef atlas;
+  workflow::ArtifactRef motion;
+};
+
+ToyLegAndWalk toy_leg_and_walk(test::NodeHarness& harness, double end_time) {
+  ToyLegAndWalk result{mmm::test::toy_leg(), {}, {}};
   for (const auto& [name, x] : {std::pair{"R.ASIS", 150.0}, {"L.ASIS", -60.0}}) {
-    leg.atlas.markers.push_back({name, "pelvis", Eigen::Vector3d(x, 30, 20), true});
+    result.leg.atlas.markers.push_back({name, "pelvis", Eigen::Vector3d(x, 30, 20), true});
   }
-  leg.atlas.markers.push_back({"V.Sacral", "pelvis", Eigen::Vector3d(45, -120, 30), true});
-  atlas::write_atlas_with_meshes(leg.atlas, leg.meshes, harness.folder() / "toy");
-  const workflow::ArtifactRef atlas =
-      harness.add(PortType::kAtlas, pack_directory(harness.folder() / "toy"));
+  result.leg.atlas.markers.push_back({"V.Sacral", "pelvis", Eigen::Vector3d(45, -120, 30), true});
+  atlas::write_atlas_with_meshes(result.leg.atlas, result.leg.meshes, harness.folder() / "toy");
+  result.atlas = harness.add(PortType::kAtlas, pack_directory(harness.folder() / "toy"));
   const auto fused = harness.run<FuseMotion>(
-      {{"atlas", atlas},
+      {{"atlas", result.atlas},
        {"model",
         harness.add_file(PortType::kFile, pipelines() / "reference" / "subject01_simbody.osim")},
        {"trial", harness.add_file(PortType::kFile, pipelines() / "subject01_walk1.trc")}},
-      {{"start_time", 0.5}, {"end_time", 0.7}});
-  const auto outputs = harness.run<WrapMuscles>({{"atlas", atlas}, {"motion", fused.at("motion")}},
+      {{"start_time", 0.5}, {"end_time", end_time}});
+  result.motion = fused.at("motion");
+  return result;
+}
+
+TEST(WrapMusclesNodeTest, WrapsTheToyLegsMuscleOverARetargetedWalk) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.7);
+  const mmm::test::ToyLeg& leg = toy.leg;
+  const workflow::ArtifactRef& atlas = toy.atlas;
+  const auto outputs = harness.run<WrapMuscles>({{"atlas", atlas}, {"motion", toy.motion}},
                                                 {{"animation_stride", std::int64_t{2}}});
   const nlohmann::json report =
       nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
@@ -73,6 +89,41 @@ TEST(WrapMusclesNodeTest, WrapsTheToyLegsMuscleOverARetargetedWalk) {
   EXPECT_EQ(muscle_frames, (frames + 1) / 2);
   EXPECT_TRUE(std::filesystem::exists(animation / "wrapping" / "action_lines_0000.vtp"));
   EXPECT_TRUE(std::filesystem::exists(animation / "wrapping" / "femur_r_0000.vtp"));
+}
+
+TEST(WrapMusclesNodeTest, StoredHullsAreReusedWhileTheSurfaceAndFaceCountMatch) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.55);
+  const auto hulls =
+      harness.run<BuildHulls>({{"atlas", toy.atlas}}, {{"hull_faces", std::int64_t{60}}});
+  const nlohmann::json hull_report =
+      nlohmann::json::parse(mmm::test::read_text(hulls.at("report").path));
+  EXPECT_EQ(hull_report["vertices_outside"], 0);
+  ASSERT_EQ(hull_report["muscles"].size(), toy.leg.atlas.muscles.size());
+  EXPECT_LE(hull_report["muscles"][0]["faces_after"].get<int>(), 60);
+
+  const auto wrap_report = [&](std::int64_t hull_faces) {
+    const auto outputs = harness.run<WrapMuscles>(
+        {{"atlas", toy.atlas}, {"motion", toy.motion}, {"hulls", hulls.at("hulls")}},
+        {{"hull_faces", hull_faces}});
+    return nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+  };
+  const nlohmann::json reused = wrap_report(60);
+  EXPECT_EQ(reused["hulls_built_here"], 0);
+  EXPECT_TRUE(reused["muscles"][0]["hull"]["reused"].get<bool>());
+  EXPECT_EQ(reused["muscles"][0]["hull"]["build_s"].get<double>(), 0.0);
+  EXPECT_LT(reused["max_abs_volume_error_percent"].get<double>(), 1e-5);
+  EXPECT_LE(reused["max_depth_mm"].get<double>(), 0.1 + 1e-9);
+
+  const std::size_t warnings_before = harness.log().size();
+  const nlohmann::json rebuilt = wrap_report(80);  // another face count: not the stored hull
+  EXPECT_EQ(rebuilt["hulls_built_here"], static_cast<int>(toy.leg.atlas.muscles.size()));
+  EXPECT_FALSE(rebuilt["muscles"][0]["hull"]["reused"].get<bool>());
+  bool warned = false;
+  for (std::size_t i = warnings_before; i < harness.log().size(); ++i)
+    warned =
+        warned || harness.log()[i].find("give build_hulls the same atlas") != std::string::npos;
+  EXPECT_TRUE(warned);
 }
 
 TEST(WrapMusclesNodeTest, AMotionOfAnOpenSimModelIsRefusedWithAHint) {
