@@ -14,7 +14,7 @@ namespace {
 Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& m) {
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d u = svd.matrixU();
-  const Eigen::Matrix3d v = svd.matrixV();
+  const Eigen::Matrix3d& v = svd.matrixV();
   if ((u * v.transpose()).determinant() < 0.0) u.col(2) = -u.col(2);
   return u * v.transpose();
 }

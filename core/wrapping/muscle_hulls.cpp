@@ -1,5 +1,6 @@
 #include "core/wrapping/muscle_hulls.h"
 
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cstdint>
@@ -53,8 +54,8 @@ mesh::IndexedMesh wrapping_surface(const atlas::Muscle& muscle,
 
 std::string mesh_hash(const mesh::IndexedMesh& mesh) {
   hash::Sha256 sha;
-  const std::int64_t counts[2] = {mesh.V.rows(), mesh.F.rows()};
-  sha.update(std::string_view(reinterpret_cast<const char*>(counts), sizeof(counts)));
+  const std::array<std::int64_t, 2> counts = {mesh.V.rows(), mesh.F.rows()};
+  sha.update(std::string_view(reinterpret_cast<const char*>(counts.data()), sizeof(counts)));
   // Row by row, so that the storage order of the matrices does not matter.
   for (Eigen::Index v = 0; v < mesh.V.rows(); ++v) {
     const Eigen::Vector3d p = mesh.V.row(v).transpose();

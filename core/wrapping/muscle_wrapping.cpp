@@ -193,7 +193,7 @@ class MuscleWrapper {
                 const std::filesystem::path& dir, const motion::Skeleton& skeleton,
                 const PosedBones& bones, const VectorXd& rest_q,
                 const MuscleWrappingOptions& options)
-      : atlas_(atlas), muscle_(muscle), skeleton_(skeleton), bones_(bones), options_(options) {
+      : muscle_(muscle), skeleton_(skeleton), bones_(bones), options_(options) {
     const Clock::time_point start = Clock::now();
     if (muscle.action_lines.empty()) {
       throw InvalidInputError("muscle wrapping: muscle '" + muscle.name + "' has no action line");
@@ -380,7 +380,6 @@ class MuscleWrapper {
     return solved;
   }
 
-  const atlas::Atlas& atlas_;
   const atlas::Muscle& muscle_;
   const motion::Skeleton& skeleton_;
   const PosedBones& bones_;

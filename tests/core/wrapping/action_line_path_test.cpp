@@ -78,7 +78,7 @@ TEST(ActionLinePathTest, AnObstacleOnTheFemurBendsThePathAroundIt) {
   EXPECT_GT(path.length, (path.points.back() - path.points.front()).norm());
 }
 
-TEST(ActionLinePathTest, UnknownObstaclesAndEllipsoidsAreErrors) {
+TEST(ActionLinePathTest, UnknownObstaclesAndDegenerateEllipsoidsAreErrors) {
   test::ToyLeg leg = test::toy_leg();
   atlas::Muscle& muscle = leg.atlas.muscles.front();
   const motion::Skeleton skeleton = motion::skeleton_from_atlas(leg.atlas);
@@ -88,8 +88,11 @@ TEST(ActionLinePathTest, UnknownObstaclesAndEllipsoidsAreErrors) {
                InvalidInputError);
   muscle.action_lines.front().wrap_obstacles = {muscle.wrap_obstacles.front().name};
   muscle.wrap_obstacles.front().shape = atlas::WrapShape::kEllipsoid;
+  muscle.wrap_obstacles.front().radii = Eigen::Vector3d(20, 0, 10);  // a zero semi-axis
   EXPECT_THROW(action_line_path(leg.atlas, muscle, muscle.action_lines.front(), skeleton, q),
                InvalidInputError);
+  muscle.wrap_obstacles.front().radii = Eigen::Vector3d(20, 15, 10);  // a proper ellipsoid
+  EXPECT_NO_THROW(action_line_path(leg.atlas, muscle, muscle.action_lines.front(), skeleton, q));
 }
 
 }  // namespace

@@ -63,7 +63,7 @@ struct ToyRouting {
     const Eigen::Vector3d a = path.points.front();
     const Eigen::Vector3d b = path.points.back();
     const int n = static_cast<int>((b - a).norm());
-    for (int i = 0; i <= n; ++i) samples.points.push_back(a + (b - a) * i / n);
+    for (int i = 0; i <= n; ++i) samples.points.emplace_back(a + (b - a) * i / n);
     return path.points.size() == 2 && clearance(samples, q) < 0.0;
   }
 

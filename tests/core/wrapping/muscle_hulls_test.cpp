@@ -106,7 +106,7 @@ TEST(MuscleHullsTest, BrokenHullFoldersAreErrorsNamingTheFile) {
   EXPECT_NE(message_of(dir.path() / "h").find("ball.ply"), std::string::npos);
 
   write_hulls(dir.path() / "h", {build_muscle_hull("ball", mesh::make_icosphere(3), 100)});
-  std::ofstream(dir.path() / "h" / "hulls.json") << "{\"hulls\": [{\"muscle\": 3}]}";
+  std::ofstream(dir.path() / "h" / "hulls.json") << R"({"hulls": [{"muscle": 3}]})";
   EXPECT_NE(message_of(dir.path() / "h").find("malformed hull index"), std::string::npos);
 
   write_hulls(dir.path() / "h", {build_muscle_hull("ball", mesh::make_icosphere(3), 100)});
