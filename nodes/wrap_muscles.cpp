@@ -25,6 +25,7 @@ wrapping::MuscleWrappingOptions options_from(const workflow::NodeContext& contex
   wrapping::MuscleWrappingOptions options;
   options.target_faces = context.integer("target_faces");
   options.bone_contacts = context.flag("bone_contacts");
+  options.muscle_penetration = context.flag("muscle_penetration");
   options.intermediate_poses = static_cast<int>(context.integer("intermediate_poses"));
   options.first_frame_intermediate_poses =
       static_cast<int>(context.integer("first_frame_intermediate_poses"));
@@ -51,21 +52,27 @@ std::string fixed(double value, int decimals) {
 std::string metrics_csv(const wrapping::MuscleWrapping& wrapped) {
   std::string csv =
       "muscle,frame,time_s,volume_error_percent,max_depth_mm,vertices_inside,vertices_deeper,"
-      "deepest_bone,"
+      "deepest_bone,muscle_depth_mm,muscle_vertices_deeper,deepest_muscle,"
       "smoothness_change_percent,contacts,hull_contacts,path_contacts,contact_rounds,volume_"
       "iterations,converged,ms\n";
   for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
     for (std::size_t f = 0; f < muscle.frames.size(); ++f) {
       const wrapping::MuscleFrameMetrics& m = muscle.frames[f];
-      csv += muscle.name + "," + std::to_string(f) + "," +
-             fixed(wrapped.times(static_cast<Eigen::Index>(f)), 4) + "," +
-             fixed(m.volume_error_percent, 8) + "," + fixed(m.max_depth_mm, 3) + "," +
-             std::to_string(m.vertices_inside) + "," + std::to_string(m.vertices_deeper) + "," +
-             m.deepest_bone + "," + fixed(m.smoothness_change_percent, 2) + "," +
-             std::to_string(m.contacts) + "," + std::to_string(m.hull_contacts) + "," +
-             std::to_string(m.path_contacts) + "," + std::to_string(m.contact_rounds) + "," +
-             std::to_string(m.volume_iterations) + "," + (m.converged ? "1" : "0") + "," +
-             fixed(1000.0 * m.seconds, 2) + "\n";
+      csv +=
+          muscle.name + "," + std::to_string(f) + "," +
+          fixed(wrapped.times(static_cast<Eigen::Index>(f)), 4) + "," +
+          fixed(m.volume_error_percent, 8) + "," + fixed(m.max_depth_mm, 3) + "," +
+          std::to_string(m.vertices_inside) + "," + std::to_string(m.vertices_deeper) + "," +
+          m.deepest_bone + "," +
+          (wrapped.muscle_penetration ? fixed(m.muscle_depth_mm, 3) : std::string()) + "," +
+          (wrapped.muscle_penetration ? std::to_string(m.muscle_vertices_deeper) : std::string()) +
+          "," +
+          (m.deepest_muscle >= 0 ? wrapped.muscles[static_cast<std::size_t>(m.deepest_muscle)].name
+                                 : std::string()) +
+          "," + fixed(m.smoothness_change_percent, 2) + "," + std::to_string(m.contacts) + "," +
+          std::to_string(m.hull_contacts) + "," + std::to_string(m.path_contacts) + "," +
+          std::to_string(m.contact_rounds) + "," + std::to_string(m.volume_iterations) + "," +
+          (m.converged ? "1" : "0") + "," + fixed(1000.0 * m.seconds, 2) + "\n";
     }
   }
   return csv;
@@ -99,31 +106,36 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
   std::vector<double> all_ms;
   double worst_volume = 0.0;
   double worst_depth = 0.0;
+  double worst_muscle_depth = 0.0;
   int unconverged = 0;
   for (const wrapping::WrappedMuscle& muscle : wrapped.muscles) {
     const wrapping::MuscleWrappingSummary summary = wrapping::summarise(muscle);
     all_ms.insert(all_ms.end(), summary.ms_per_frame.begin(), summary.ms_per_frame.end());
     worst_volume = std::max(worst_volume, summary.max_abs_volume_error_percent);
     worst_depth = std::max(worst_depth, summary.max_depth_mm);
+    worst_muscle_depth = std::max(worst_muscle_depth, summary.max_muscle_depth_mm);
     unconverged += summary.unconverged_frames;
-    muscles.push_back({{"muscle", muscle.name},
-                       {"faces", muscle.rest.F.rows()},
-                       {"rest_volume_mm3", muscle.rest_volume_mm3},
-                       {"rest_max_depth_mm", muscle.rest_penetration.max_depth_mm},
-                       {"max_abs_volume_error_percent", summary.max_abs_volume_error_percent},
-                       {"max_depth_mm", summary.max_depth_mm},
-                       {"vertex_frames_deeper_than_tolerance", summary.vertex_frames_deeper},
-                       {"max_smoothness_change_percent", summary.max_smoothness_change_percent},
-                       {"median_ms_per_frame", summary.median_ms_per_frame},
-                       {"setup_s", muscle.setup_seconds},
-                       {"hull",
-                        {{"faces", muscle.hull_faces},
-                         {"reused", muscle.hull_reused},
-                         {"build_s", muscle.hull_build_seconds},
-                         {"volume_mm3", muscle.hull_volume_mm3},
-                         {"vertices_outside", muscle.hull_vertices_outside},
-                         {"max_outside_mm", muscle.hull_max_outside_mm},
-                         {"max_depth_of_surface_inside_mm", muscle.hull_max_offset_mm}}}});
+    muscles.push_back(
+        {{"muscle", muscle.name},
+         {"faces", muscle.rest.F.rows()},
+         {"rest_volume_mm3", muscle.rest_volume_mm3},
+         {"rest_max_depth_mm", muscle.rest_penetration.max_depth_mm},
+         {"max_abs_volume_error_percent", summary.max_abs_volume_error_percent},
+         {"max_depth_mm", summary.max_depth_mm},
+         {"vertex_frames_deeper_than_tolerance", summary.vertex_frames_deeper},
+         {"max_depth_in_other_muscles_mm", summary.max_muscle_depth_mm},
+         {"vertex_frames_deeper_in_other_muscles", summary.muscle_vertex_frames_deeper},
+         {"max_smoothness_change_percent", summary.max_smoothness_change_percent},
+         {"median_ms_per_frame", summary.median_ms_per_frame},
+         {"setup_s", muscle.setup_seconds},
+         {"hull",
+          {{"faces", muscle.hull_faces},
+           {"reused", muscle.hull_reused},
+           {"build_s", muscle.hull_build_seconds},
+           {"volume_mm3", muscle.hull_volume_mm3},
+           {"vertices_outside", muscle.hull_vertices_outside},
+           {"max_outside_mm", muscle.hull_max_outside_mm},
+           {"max_depth_of_surface_inside_mm", muscle.hull_max_offset_mm}}}});
   }
   return {{"frames", wrapped.times.size()},
           {"muscles", muscles},
@@ -132,6 +144,9 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
           {"median_ms_per_muscle_frame", wrapping::median(all_ms)},
           {"max_abs_volume_error_percent", worst_volume},
           {"max_depth_mm", worst_depth},
+          {"muscle_penetration_measured", wrapped.muscle_penetration},
+          {"max_depth_in_other_muscles_mm", worst_muscle_depth},
+          {"muscle_penetration_s", wrapped.muscle_penetration_seconds},
           {"unconverged_muscle_frames", unconverged},
           {"targets",
            {{"volume_error_within_0.5_percent", worst_volume <= 0.5},
@@ -231,6 +246,9 @@ workflow::NodeSpec WrapMuscles::spec() {
           {.min = 0, .max = 1000000})
       .param<bool>("bone_contacts", d.bone_contacts,
                    "Keep the muscles out of the bones (impenetrability)")
+      .param<bool>("muscle_penetration", d.muscle_penetration,
+                   "Measure how far the muscles run into each other beyond their overlap at "
+                   "rest (a metric: nothing keeps them apart)")
       .param_enum("path_method", "obstacle_set", {"obstacle_set", "global"},
                   "Action-line paths: straight between the path points and wrapped over the "
                   "atlas's fitted obstacles, or the shortest path keeping clear of the bone "

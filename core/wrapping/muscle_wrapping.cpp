@@ -20,6 +20,7 @@
 #include "core/mesh/laplacian.h"
 #include "core/motion/skeleton.h"
 #include "core/wrapping/hull_embedding.h"
+#include "core/wrapping/muscle_penetration.h"
 
 namespace mmm::wrapping {
 namespace {
@@ -466,6 +467,12 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
   work();
   for (std::thread& thread : pool) thread.join();
   if (failure) std::rethrow_exception(failure);
+  if (options.muscle_penetration && result.muscles.size() > 1) {
+    const Clock::time_point measuring = Clock::now();
+    measure_muscle_penetration(result, options.contacts.tolerance_mm, threads);
+    result.muscle_penetration = true;
+    result.muscle_penetration_seconds = seconds_since(measuring);
+  }
   result.seconds = seconds_since(start);
   return result;
 }

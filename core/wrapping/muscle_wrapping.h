@@ -37,7 +37,10 @@ namespace mmm::wrapping {
 struct MuscleWrappingOptions {
   Eigen::Index target_faces = 10000;  // wrapping resolution; 0: the full mesh
   bool bone_contacts = true;          // impenetrability with the bones
-  int intermediate_poses = 0;         // >= 0, between consecutive frames
+  // Measure how far the wrapped muscles run into each other, per frame
+  // (muscle_penetration.h); a metric only: nothing keeps them apart.
+  bool muscle_penetration = true;
+  int intermediate_poses = 0;  // >= 0, between consecutive frames
   // Between the rest pose and the first frame, usually far apart: a vertex
   // driven deep into a bone in one step is projected out across a crowd of
   // others (folds); in small steps it is pushed out where it enters.
@@ -70,6 +73,13 @@ struct MuscleFrameMetrics {
   int vertices_inside = 0;    // inside a bone at any depth
   int vertices_deeper = 0;    // deeper than the contact tolerance
   std::string deepest_bone;
+  // With options.muscle_penetration: the deepest vertex inside another
+  // muscle beyond its depth there at rest, the vertices deeper than that by
+  // the contact tolerance, and that muscle (index into
+  // MuscleWrapping::muscles; -1: none).
+  double muscle_depth_mm = 0.0;
+  int muscle_vertices_deeper = 0;
+  int deepest_muscle = -1;
   double smoothness_change_percent = 0.0;  // bending energy sum |L x|^2 vs rest
   int contacts = 0;
   int path_contacts = 0;  // global paths: segments resting on a bone
@@ -116,6 +126,8 @@ struct MuscleWrapping {
   std::vector<std::vector<Eigen::Isometry3d>> bone_poses;  // [frame][bone], rest -> frame
   double seconds = 0.0;                                    // wall time of the whole wrapping
   int threads = 1;
+  bool muscle_penetration = false;          // measured (options.muscle_penetration)
+  double muscle_penetration_seconds = 0.0;  // of that measurement (included in seconds)
 };
 
 // atlas + its folder (meshes), a motion fused on a skeleton of this atlas

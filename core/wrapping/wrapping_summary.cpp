@@ -25,6 +25,8 @@ MuscleWrappingSummary summarise(const WrappedMuscle& muscle) {
     summary.max_smoothness_change_percent =
         std::max(summary.max_smoothness_change_percent, frame.smoothness_change_percent);
     summary.vertex_frames_deeper += frame.vertices_deeper;
+    summary.max_muscle_depth_mm = std::max(summary.max_muscle_depth_mm, frame.muscle_depth_mm);
+    summary.muscle_vertex_frames_deeper += frame.muscle_vertices_deeper;
     if (!frame.converged) ++summary.unconverged_frames;
     summary.ms_per_frame.push_back(1000.0 * frame.seconds);
   }
@@ -66,7 +68,13 @@ std::string wrapping_metrics_svg(const MuscleWrapping& wrapped, const std::strin
   layout.panel_width = 560;
   layout.panel_height = 420;
   layout.title = title;
-  return plot::svg_small_multiples({volume, depth, time, bending}, layout);
+  std::vector<plot::Chart> charts = {volume, depth, time, bending};
+  if (wrapped.muscle_penetration) {
+    charts.push_back(chart("Deepest vertex in another muscle, beyond its rest overlap",
+                           "depth (mm)",
+                           [](const MuscleFrameMetrics& f) { return f.muscle_depth_mm; }));
+  }
+  return plot::svg_small_multiples(charts, layout);
 }
 
 }  // namespace mmm::wrapping
