@@ -94,12 +94,12 @@ void measure_muscle_penetration(MuscleWrapping& wrapped, double tolerance_mm, in
   parallel_for(muscles, threads, [&](std::size_t m) {
     overlaps[m] = rest_overlap(static_cast<int>(m), rest[m], rest_surfaces);
   });
-  const std::size_t frames = static_cast<std::size_t>(wrapped.times.size());
+  const auto frames = static_cast<std::size_t>(wrapped.times.size());
   parallel_for(frames, threads, [&](std::size_t f) {
     std::vector<Eigen::MatrixX3d> positions;
     positions.reserve(muscles);
     for (const WrappedMuscle& muscle : wrapped.muscles)
-      positions.push_back(muscle.positions[f].cast<double>());
+      positions.emplace_back(muscle.positions[f].cast<double>());
     const MuscleSurfaces now(positions, faces, 1);
     for (std::size_t m = 0; m < muscles; ++m) {
       const MusclePenetration p = measure_muscle_penetration(static_cast<int>(m), positions[m], now,
