@@ -174,7 +174,7 @@ WalkSummary summarise_walk(const wrapping::MuscleWrapping& wrapped) {
     all_ms.insert(all_ms.end(), summary.ms_per_frame.begin(), summary.ms_per_frame.end());
   }
   walk.median_ms = wrapping::median(all_ms);
-  walk.seconds = wrapped.seconds;
+  walk.seconds = wrapped.seconds - wrapped.muscle_penetration_seconds;  // the wrapping itself
   return walk;
 }
 
@@ -216,7 +216,8 @@ nlohmann::json write_variants_table(std::ostringstream& out, const WalkSummary& 
 }
 
 nlohmann::json write_trial_table(std::ostringstream& out) {
-  const mmm::wrapping::MuscleWrappingOptions options;
+  mmm::wrapping::MuscleWrappingOptions options;
+  options.muscle_penetration = true;  // the metric, timed apart
   const wrapping::MuscleWrapping wrapped =
       wrapping::wrap_muscles(models().atlas, atlas_dir(), atlas_walk(), options);
   out << "\nwhole walk, energy pathway with bone impenetrability: " << wrapped.muscles.size()
@@ -279,10 +280,11 @@ nlohmann::json write_trial_table(std::ostringstream& out) {
       << " ms; 9-10K-face muscles " << wrapping::median(ten_k_ms)
       << " ms (target 50; reference 500 ms without collisions, 23 s with bones, "
       << "20.1 s gluteus maximus)\n"
-      << "whole walk " << wrapped.seconds << " s on " << wrapped.threads
-      << " threads (target 60 s; reference 188.6 s), of which "
-      << wrapped.muscle_penetration_seconds
-      << " s measuring muscle-muscle penetration (not prevented)\n";
+      << "whole walk " << wrapped.seconds - wrapped.muscle_penetration_seconds << " s on "
+      << wrapped.threads
+      << " threads (target 60 s; reference 188.6 s); measuring muscle-muscle penetration (not "
+         "prevented) "
+      << wrapped.muscle_penetration_seconds << " s more\n";
   // The plot of volume error, depth, time and bending over the walk.
   const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
   mmm::plot::write_svg(
@@ -294,7 +296,7 @@ nlohmann::json write_trial_table(std::ostringstream& out) {
           {"variants", variants},
           {"frames", wrapped.times.size()},
           {"threads", wrapped.threads},
-          {"whole_walk_s", wrapped.seconds},
+          {"whole_walk_s", wrapped.seconds - wrapped.muscle_penetration_seconds},
           {"muscle_penetration_s", wrapped.muscle_penetration_seconds},
           {"median_ms_per_muscle_frame", wrapping::median(all_ms)},
           {"median_ms_per_10k_face_muscle_frame", wrapping::median(ten_k_ms)},

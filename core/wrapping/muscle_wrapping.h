@@ -38,8 +38,10 @@ struct MuscleWrappingOptions {
   Eigen::Index target_faces = 10000;  // wrapping resolution; 0: the full mesh
   bool bone_contacts = true;          // impenetrability with the bones
   // Measure how far the wrapped muscles run into each other, per frame
-  // (muscle_penetration.h); a metric only: nothing keeps them apart.
-  bool muscle_penetration = true;
+  // (muscle_penetration.h); a metric only: nothing keeps them apart. Costs
+  // about as much again as the wrapping (every pair of touching muscles,
+  // every frame).
+  bool muscle_penetration = false;
   int intermediate_poses = 0;  // >= 0, between consecutive frames
   // Between the rest pose and the first frame, usually far apart: a vertex
   // driven deep into a bone in one step is projected out across a crowd of
