@@ -26,6 +26,9 @@ wrapping::MuscleWrappingOptions options_from(const workflow::NodeContext& contex
   options.target_faces = context.integer("target_faces");
   options.bone_contacts = context.flag("bone_contacts");
   options.muscle_penetration = context.flag("muscle_penetration");
+  options.muscle_contacts = context.flag("muscle_contacts");
+  options.muscle_contact.weight = context.number("muscle_contact_weight");
+  options.muscle_contact_rounds = static_cast<int>(context.integer("muscle_contact_rounds"));
   options.intermediate_poses = static_cast<int>(context.integer("intermediate_poses"));
   options.first_frame_intermediate_poses =
       static_cast<int>(context.integer("first_frame_intermediate_poses"));
@@ -128,6 +131,10 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
          {"max_smoothness_change_percent", summary.max_smoothness_change_percent},
          {"median_ms_per_frame", summary.median_ms_per_frame},
          {"setup_s", muscle.setup_seconds},
+         {"separation",
+          {{"overlap_at_rest_mm", muscle.rest_overlap_before_mm},
+           {"overlap_after_mm", muscle.rest_overlap_after_mm},
+           {"max_move_mm", muscle.separation_move_mm}}},
          {"hull",
           {{"faces", muscle.hull_faces},
            {"reused", muscle.hull_reused},
@@ -147,6 +154,9 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
           {"muscle_penetration_measured", wrapped.muscle_penetration},
           {"max_depth_in_other_muscles_mm", worst_muscle_depth},
           {"muscle_penetration_s", wrapped.muscle_penetration_seconds},
+          {"muscle_contacts", options.muscle_contacts},
+          {"separation_s", wrapped.separation_seconds},
+          {"separation_rounds", wrapped.separation_rounds},
           {"unconverged_muscle_frames", unconverged},
           {"targets",
            {{"volume_error_within_0.5_percent", worst_volume <= 0.5},
@@ -164,7 +174,10 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
             {"first_frame_intermediate_poses", options.first_frame_intermediate_poses},
             {"stiffness_length_mm", options.deformer.stiffness_length_mm},
             {"contact_tolerance_mm", options.contacts.tolerance_mm},
-            {"contact_clearance_mm", options.contacts.clearance_mm}}}};
+            {"contact_clearance_mm", options.contacts.clearance_mm},
+            {"muscle_contacts", options.muscle_contacts},
+            {"muscle_contact_weight", options.muscle_contact.weight},
+            {"muscle_contact_rounds", options.muscle_contact_rounds}}}};
 }
 
 std::string animation_bundle(const workflow::NodeContext& context,
@@ -227,7 +240,7 @@ workflow::NodeSpec WrapMuscles::spec() {
   using workflow::port::File;
   using workflow::port::Report;
   const wrapping::MuscleWrappingOptions d;
-  return workflow::NodeSpec{"wrap_muscles", 1,
+  return workflow::NodeSpec{"wrap_muscles", 2,
                             "Muscle wrapping over a fused motion (energy pathway): per frame, "
                             "action lines re-routed on the "
                             "moving skeleton; each muscle surface deformed around them with its "
@@ -248,7 +261,17 @@ workflow::NodeSpec WrapMuscles::spec() {
                    "Keep the muscles out of the bones (impenetrability)")
       .param<bool>("muscle_penetration", d.muscle_penetration,
                    "Measure how far the muscles run into each other beyond their overlap at "
-                   "rest (a metric: nothing keeps them apart)")
+                   "rest (a metric; muscle_contacts measures it too)")
+      .param<bool>("muscle_contacts", d.muscle_contacts,
+                   "Keep the muscles out of each other: overlaps at rest resolved once, then "
+                   "per pose, two overlapping muscles meet between their surfaces (slower: "
+                   "the muscles go pose by pose together)")
+      .param<double>("muscle_contact_weight", d.muscle_contact.weight,
+                     "How firmly a vertex in contact with another muscle is held (bone "
+                     "contacts: 10000); softer keeps surfaces smoother, firmer closer",
+                     {.min = 0.01, .max = 1e6})
+      .param<std::int64_t>("muscle_contact_rounds", d.muscle_contact_rounds,
+                           "Rounds of contacts between muscles per pose", {.min = 1, .max = 10})
       .param_enum("path_method", "obstacle_set", {"obstacle_set", "global"},
                   "Action-line paths: straight between the path points and wrapped over the "
                   "atlas's fitted obstacles, or the shortest path keeping clear of the bone "

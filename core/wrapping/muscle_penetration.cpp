@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <string>
 
 #include "core/errors.h"
@@ -17,20 +19,82 @@ Eigen::AlignedBox3d bounds(const Eigen::MatrixX3d& x) {
   return box;
 }
 
-// Calls visit(n, v, depth) for every vertex v of x inside another muscle n.
+// Whether p, whose nearest point of a closed surface is `closest`, is inside
+// it: when that point is inside a face, by the side of the face p is on
+// (exact); on an edge or a corner, by the winding number.
+bool inside(const mesh::SignedDistance& surface, const mesh::AabbTree::ClosestPoint& closest,
+            const Eigen::Vector3d& p) {
+  constexpr double kInterior = 1e-6;
+  if (closest.barycentric.minCoeff() > kInterior) {
+    const Eigen::MatrixX3d& vertices = surface.tree().mesh().V;
+    const Eigen::MatrixX3i& faces = surface.tree().mesh().F;
+    const Eigen::Vector3d a = vertices.row(faces(closest.face, 0)).transpose();
+    const Eigen::Vector3d b = vertices.row(faces(closest.face, 1)).transpose();
+    const Eigen::Vector3d c = vertices.row(faces(closest.face, 2)).transpose();
+    return (p - closest.point).dot((b - a).cross(c - a)) < 0.0;
+  }
+  return surface.winding().is_inside(p);
+}
+
+// Calls visit(n, v, depth, closest) for every vertex v of x inside another
+// muscle n (closest: the nearest point of n's surface). With a finite
+// `reach` (mm), only vertices within it of n's surface are looked at (a
+// bounded closest-point query first, the inside test after); `record`, when
+// given, receives every vertex's clearance from each muscle whose box meets
+// x's, and `known`, when given, skips the vertices that have not moved
+// further than their clearance since it was recorded.
 template <typename Visit>
 void for_each_inside(int self, const Eigen::MatrixX3d& x, const MuscleSurfaces& others,
-                     const Visit& visit) {
+                     const Visit& visit, double reach = std::numeric_limits<double>::infinity(),
+                     MuscleClearance* record = nullptr, const MuscleClearance* known = nullptr) {
   const Eigen::AlignedBox3d own = bounds(x);
+  Eigen::VectorXd moved;
+  if (known != nullptr) moved = (x - known->from).rowwise().norm();
+  if (record != nullptr) {
+    record->from = x;
+    record->clearance.clear();
+  }
   for (std::size_t n = 0; n < others.size(); ++n) {
     if (static_cast<int>(n) == self || !own.intersects(others.box(n))) continue;
     const mesh::SignedDistance& surface = others.surface(n);
+    const Eigen::VectorXd* was = nullptr;
+    if (known != nullptr) {
+      const auto found = known->clearance.find(static_cast<int>(n));
+      if (found != known->clearance.end()) was = &found->second;
+    }
+    Eigen::VectorXd* clearance = nullptr;
+    if (record != nullptr) {
+      clearance = &record->clearance[static_cast<int>(n)];
+      clearance->resize(x.rows());
+    }
     for (Eigen::Index v = 0; v < x.rows(); ++v) {
       const Eigen::Vector3d p = x.row(v).transpose();
-      if (!others.box(n).contains(p) || !surface.winding().is_inside(p)) continue;
-      visit(static_cast<int>(n), v, std::sqrt(surface.tree().closest_point(p).squared_distance));
+      if (clearance != nullptr) (*clearance)[v] = others.box(n).exteriorDistance(p);
+      if (was != nullptr && moved[v] < (*was)[v]) continue;
+      if (!others.box(n).contains(p)) continue;
+      if (std::isfinite(reach)) {
+        const std::optional<mesh::AabbTree::ClosestPoint> near =
+            surface.tree().closest_point_within(p, reach * reach);
+        if (clearance != nullptr) (*clearance)[v] = reach;
+        if (!near) continue;
+        const bool in = inside(surface, *near, p);
+        if (clearance != nullptr) (*clearance)[v] = in ? 0.0 : std::sqrt(near->squared_distance);
+        if (!in) continue;
+        visit(static_cast<int>(n), v, std::sqrt(near->squared_distance), *near);
+        continue;
+      }
+      if (!surface.winding().is_inside(p)) continue;
+      const mesh::AabbTree::ClosestPoint closest = surface.tree().closest_point(p);
+      visit(static_cast<int>(n), v, std::sqrt(closest.squared_distance), closest);
     }
   }
+}
+
+Eigen::Vector3d face_normal(const Eigen::MatrixX3d& x, const Eigen::MatrixX3i& faces, int f) {
+  const Eigen::Vector3d a = x.row(faces(f, 0)).transpose();
+  const Eigen::Vector3d b = x.row(faces(f, 1)).transpose();
+  const Eigen::Vector3d c = x.row(faces(f, 2)).transpose();
+  return (b - a).cross(c - a).normalized();
 }
 
 double rest_depth(const RestOverlap& rest, int n, Eigen::Index v) {
@@ -56,11 +120,13 @@ MuscleSurfaces::MuscleSurfaces(const std::vector<Eigen::MatrixX3d>& positions,
 
 RestOverlap rest_overlap(int self, const Eigen::MatrixX3d& x, const MuscleSurfaces& others) {
   RestOverlap overlap;
-  for_each_inside(self, x, others, [&](int n, Eigen::Index v, double depth) {
-    auto [entry, added] = overlap.try_emplace(n);
-    if (added) entry->second = Eigen::VectorXd::Zero(x.rows());
-    entry->second[v] = depth;
-  });
+  for_each_inside(
+      self, x, others,
+      [&](int n, Eigen::Index v, double depth, const mesh::AabbTree::ClosestPoint& /*closest*/) {
+        auto [entry, added] = overlap.try_emplace(n);
+        if (added) entry->second = Eigen::VectorXd::Zero(x.rows());
+        entry->second[v] = depth;
+      });
   return overlap;
 }
 
@@ -69,16 +135,124 @@ MusclePenetration measure_muscle_penetration(int self, const Eigen::MatrixX3d& x
                                              double tolerance_mm) {
   MusclePenetration result;
   std::vector<char> deeper(static_cast<std::size_t>(x.rows()), 0);
-  for_each_inside(self, x, others, [&](int n, Eigen::Index v, double depth) {
-    const double excess = depth - rest_depth(rest, n, v);
-    if (excess > result.max_depth_mm) {
-      result.max_depth_mm = excess;
-      result.deepest_muscle = n;
-    }
-    if (excess > tolerance_mm) deeper[static_cast<std::size_t>(v)] = 1;
-  });
+  for_each_inside(
+      self, x, others,
+      [&](int n, Eigen::Index v, double depth, const mesh::AabbTree::ClosestPoint& /*closest*/) {
+        const double excess = depth - rest_depth(rest, n, v);
+        if (excess > result.max_depth_mm) {
+          result.max_depth_mm = excess;
+          result.deepest_muscle = n;
+        }
+        if (excess > tolerance_mm) deeper[static_cast<std::size_t>(v)] = 1;
+      });
   result.vertices_deeper = static_cast<int>(std::count(deeper.begin(), deeper.end(), 1));
   return result;
+}
+
+std::vector<std::vector<Contact>> shared_muscle_contacts(
+    const std::vector<Eigen::MatrixX3d>& positions, const MuscleSurfaces& surfaces,
+    const MuscleContactOptions& options, int threads, std::vector<MuscleClearance>* clearances) {
+  if (clearances != nullptr) clearances->assign(positions.size(), MuscleClearance{});
+  const double share = options.share;
+  if (!(share >= 0.0 && share <= 1.0))
+    throw InvalidInputError("muscle contacts: the share must be in [0, 1], not " +
+                            std::to_string(share));
+  const std::size_t muscles = positions.size();
+  if (muscles != surfaces.size()) {
+    throw InvalidInputError("muscle contacts: " + std::to_string(muscles) + " vertex sets for " +
+                            std::to_string(surfaces.size()) + " surfaces");
+  }
+  struct Pin {
+    std::size_t muscle;
+    Eigen::Index vertex;
+    Eigen::Vector3d move;
+    int obstacle;
+  };
+  std::vector<std::vector<Pin>> pins(muscles);  // found from each muscle's vertices
+  parallel_for(muscles, threads, [&](std::size_t m) {
+    const Eigen::MatrixX3d& x = positions[m];
+    for_each_inside(
+        static_cast<int>(m), x, surfaces,
+        [&](int n, Eigen::Index v, double depth, const mesh::AabbTree::ClosestPoint& closest) {
+          if (depth <= options.tolerance_mm) return;
+          // Out along the other surface's normal there: vertices nearest to
+          // one of its ridges are not gathered onto the ridge.
+          const auto other = static_cast<std::size_t>(n);
+          const Eigen::MatrixX3i& faces = surfaces.faces(other);
+          const Eigen::Vector3d out = depth * face_normal(positions[other], faces, closest.face);
+          pins[m].push_back({m, v, share * out, muscle_obstacle(n)});
+          for (int corner = 0; corner < 3; ++corner) {
+            pins[m].push_back({other, faces(closest.face, corner), -(1.0 - share) * out,
+                               muscle_obstacle(static_cast<int>(m))});
+          }
+        },
+        options.reach_mm, clearances != nullptr ? &(*clearances)[m] : nullptr);
+  });
+  std::vector<std::map<Eigen::Index, std::pair<Eigen::Vector3d, int>>> longest(muscles);
+  for (const std::vector<Pin>& found : pins) {
+    for (const Pin& pin : found) {
+      auto [entry, added] = longest[pin.muscle].try_emplace(pin.vertex, pin.move, pin.obstacle);
+      if (!added && pin.move.squaredNorm() > entry->second.first.squaredNorm())
+        entry->second = {pin.move, pin.obstacle};
+    }
+  }
+  std::vector<std::vector<Contact>> contacts(muscles);
+  for (std::size_t m = 0; m < muscles; ++m) {
+    for (const auto& [vertex, entry] : longest[m]) {
+      if (entry.first.squaredNorm() == 0.0) continue;
+      const Eigen::Vector3d p = positions[m].row(vertex).transpose();
+      contacts[m].push_back(
+          {static_cast<int>(vertex), p + entry.first, entry.second, options.weight});
+    }
+  }
+  return contacts;
+}
+
+double round_share(double share, int round, int rounds) {
+  const double first = std::max(share, 1.0 - share);
+  if (rounds <= 1) return first;
+  return first + (1.0 - first) * std::clamp(round, 0, rounds - 1) / (rounds - 1);
+}
+
+bool MusclePins::add(const std::vector<std::vector<Contact>>& found) {
+  if (found.size() != pins_.size()) {
+    throw InvalidInputError("muscle pins: contacts for " + std::to_string(found.size()) +
+                            " muscles, expected " + std::to_string(pins_.size()));
+  }
+  bool any = false;
+  for (std::size_t m = 0; m < found.size(); ++m) {
+    for (const Contact& contact : found[m]) pins_[m][contact.vertex] = contact;
+    any = any || !found[m].empty();
+  }
+  return any;
+}
+
+std::vector<Contact> MusclePins::of(std::size_t muscle) const {
+  std::vector<Contact> contacts;
+  contacts.reserve(pins_[muscle].size());
+  for (const auto& [vertex, contact] : pins_[muscle]) contacts.push_back(contact);
+  return contacts;
+}
+
+std::vector<Contact> muscle_entries(int self, const Eigen::MatrixX3d& x,
+                                    const std::vector<char>& active, const MuscleSurfaces& others,
+                                    const MuscleContactOptions& options,
+                                    const MuscleClearance* clearance) {
+  std::map<Eigen::Index, std::pair<double, Contact>> deepest;  // vertex -> depth, contact
+  for_each_inside(
+      self, x, others,
+      [&](int n, Eigen::Index v, double depth, const mesh::AabbTree::ClosestPoint& closest) {
+        if (active[static_cast<std::size_t>(v)] != 0 || depth <= options.tolerance_mm) return;
+        const auto found = deepest.find(v);
+        if (found != deepest.end() && found->second.first >= depth) return;
+        deepest[v] = {
+            depth, Contact{static_cast<int>(v), closest.point, muscle_obstacle(n), options.weight}};
+      },
+      options.reach_mm, nullptr, clearance);
+  std::vector<Contact> contacts;
+  contacts.reserve(deepest.size());
+  for (const auto& [vertex, entry] : deepest) contacts.push_back(entry.second);
+  return contacts;
 }
 
 void measure_muscle_penetration(MuscleWrapping& wrapped, double tolerance_mm, int threads) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/mesh/signed_distance.h"
+#include "core/wrapping/volume_deformer.h"
 
 namespace mmm::wrapping {
 
@@ -33,6 +34,9 @@ class MuscleSurfaces {
   [[nodiscard]] std::size_t size() const { return surfaces_.size(); }
   [[nodiscard]] const mesh::SignedDistance& surface(std::size_t m) const { return *surfaces_[m]; }
   [[nodiscard]] const Eigen::AlignedBox3d& box(std::size_t m) const { return boxes_[m]; }
+  [[nodiscard]] const Eigen::MatrixX3i& faces(std::size_t m) const {
+    return surfaces_[m]->tree().mesh().F;
+  }
 
  private:
   std::vector<std::unique_ptr<mesh::SignedDistance>> surfaces_;
@@ -56,6 +60,73 @@ struct MusclePenetration {
 MusclePenetration measure_muscle_penetration(int self, const Eigen::MatrixX3d& x,
                                              const MuscleSurfaces& others, const RestOverlap& rest,
                                              double tolerance_mm);
+
+// Obstacle index of a contact with muscle n (Contact::obstacle): negative,
+// so that carrying bone contacts by bone poses leaves it alone.
+inline int muscle_obstacle(int n) { return -2 - n; }
+inline bool is_muscle_obstacle(int obstacle) { return obstacle <= -2; }
+
+// Contacts between muscles in one pose, shared out (impenetrability between
+// muscles). Wherever a vertex p of muscle m lies deeper than the tolerance
+// inside muscle n (nearest point c of n's surface, on face f), the two
+// surfaces are to meet between p and c: p is pinned `share` of the way to c,
+// and the corners of f are pinned (1 - share) of (p - c) further into n. A
+// vertex pinned several times keeps its longest move. positions[m]: muscle
+// m's vertices in this pose, the ones `surfaces` was built from. Returns the
+// contacts per muscle. Throws InvalidInputError for a share outside [0, 1]
+// or sizes that do not match.
+struct MuscleContactOptions {
+  double share = 0.5;         // [0, 1]: of an overlap, what the penetrating side moves
+  double tolerance_mm = 0.1;  // shallower overlaps are left alone
+  double weight = 1e2;        // pinning weight (soft tissue on soft tissue: softer than bone)
+  double reach_mm = 20.0;     // deeper overlaps are not looked for
+};
+
+// How far one muscle's vertices were from the others' surfaces when the
+// contacts were found: per other muscle, a lower bound of each vertex's
+// distance to its surface (0 inside, reach_mm beyond reach). A vertex that
+// has moved less than that since `from` has not entered that surface.
+struct MuscleClearance {
+  Eigen::MatrixX3d from;
+  std::map<int, Eigen::VectorXd> clearance;
+};
+
+// `clearances`, when given, receives each muscle's clearance.
+std::vector<std::vector<Contact>> shared_muscle_contacts(
+    const std::vector<Eigen::MatrixX3d>& positions, const MuscleSurfaces& surfaces,
+    const MuscleContactOptions& options, int threads,
+    std::vector<MuscleClearance>* clearances = nullptr);
+
+// Each side's share of an overlap in round `round` of `rounds`: from the
+// larger of share and 1 - share in the first to all of it in the last, so
+// that an overlap one side cannot give way to (pressed against a bone, or
+// not deformable) is still resolved by the other.
+double round_share(double share, int round, int rounds);
+
+// Shared contacts gathered over rounds, per muscle: a vertex keeps its latest
+// pin.
+class MusclePins {
+ public:
+  explicit MusclePins(std::size_t muscles) : pins_(muscles) {}
+  // Adds one round's contacts (one list per muscle); false when there were none.
+  bool add(const std::vector<std::vector<Contact>>& found);
+  [[nodiscard]] std::vector<Contact> of(std::size_t muscle) const;
+  [[nodiscard]] bool empty(std::size_t muscle) const { return pins_[muscle].empty(); }
+
+ private:
+  std::vector<std::map<int, Contact>> pins_;
+};
+
+// Vertices of muscle `self` (x) not flagged in `active` that lie deeper than
+// the tolerance inside another muscle of `others`, pinned to that muscle's
+// nearest surface point (the deepest muscle per vertex counts): new entries
+// during a solve, where the other muscle is not moving out of the way.
+// `clearance` (of x's muscle against the same surfaces) spares the vertices
+// that cannot have entered.
+std::vector<Contact> muscle_entries(int self, const Eigen::MatrixX3d& x,
+                                    const std::vector<char>& active, const MuscleSurfaces& others,
+                                    const MuscleContactOptions& options,
+                                    const MuscleClearance* clearance = nullptr);
 
 // Fills muscle_depth_mm, muscle_vertices_deeper and deepest_muscle of every
 // muscle-frame of `wrapped` (rest overlaps from the muscles' rest surfaces),

@@ -1,14 +1,11 @@
 #include "core/wrapping/muscle_wrapping.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
@@ -19,8 +16,10 @@
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/laplacian.h"
 #include "core/motion/skeleton.h"
+#include "core/parallel_for.h"
 #include "core/wrapping/hull_embedding.h"
 #include "core/wrapping/muscle_penetration.h"
+#include "core/wrapping/muscle_separation.h"
 
 namespace mmm::wrapping {
 namespace {
@@ -129,6 +128,7 @@ std::vector<Contact> carried(const std::vector<Contact>& contacts,
   std::vector<Contact> result;
   result.reserve(contacts.size());
   for (Contact contact : contacts) {
+    if (is_muscle_obstacle(contact.obstacle)) continue;  // found again against the new surfaces
     if (contact.obstacle >= 0) {
       const auto b = static_cast<std::size_t>(contact.obstacle);
       contact.target = to[b] * (from[b].inverse() * contact.target);
@@ -193,14 +193,17 @@ class MuscleWrapper {
   MuscleWrapper(const atlas::Atlas& atlas, const atlas::Muscle& muscle,
                 const std::filesystem::path& dir, const motion::Skeleton& skeleton,
                 const PosedBones& bones, const VectorXd& rest_q,
-                const MuscleWrappingOptions& options)
+                const MuscleWrappingOptions& options,
+                const mesh::IndexedMesh* surface_at_rest = nullptr)
       : muscle_(muscle), skeleton_(skeleton), bones_(bones), options_(options) {
     const Clock::time_point start = Clock::now();
     if (muscle.action_lines.empty()) {
       throw InvalidInputError("muscle wrapping: muscle '" + muscle.name + "' has no action line");
     }
     result_.name = muscle.name;
-    const mesh::IndexedMesh surface = wrapping_surface(muscle, dir, options.target_faces);
+    const mesh::IndexedMesh surface = surface_at_rest != nullptr
+                                          ? *surface_at_rest
+                                          : wrapping_surface(muscle, dir, options.target_faces);
     result_.rest = surface;
     laplacian_ = mesh::cotangent_laplacian(surface.V, surface.F);
     rest_bending_ = bending(laplacian_, surface.V);
@@ -272,52 +275,92 @@ class MuscleWrapper {
     result_.setup_seconds = seconds_since(start);
   }
 
+  // Poses solved for the next frame (its intermediate ones, then its own).
+  [[nodiscard]] int stages() const {
+    return (result_.frames.empty() ? options_.first_frame_intermediate_poses
+                                   : options_.intermediate_poses) +
+           1;
+  }
+  [[nodiscard]] VectorXd stage_coordinates(const VectorXd& q, int stage) const {
+    const double t = static_cast<double>(stage) / stages();
+    return (1.0 - t) * previous_q_ + t * q;
+  }
+
+  // A frame, without contacts between muscles.
   void frame(const VectorXd& q) {
+    for (int stage = 1; stage <= stages(); ++stage) {
+      prepare_stage(stage_coordinates(q, stage), stage == stages());
+      solve_stage(nullptr);
+    }
+    end_frame(q);
+  }
+
+  // The pose's bones, action lines (recorded when it is the frame's own,
+  // `last`) and targets; coarse to fine: the hull's solve.
+  void prepare_stage(const VectorXd& q_stage, bool last) {
     const Clock::time_point start = Clock::now();
     motion::SkeletonPose pose(skeleton_);
-    const int frame_index = static_cast<int>(result_.frames.size());
-    DeformResult solved;
-    DeformResult hull_solved;
-    std::vector<Isometry3d> poses;
-    const int stages =
-        (frame_index == 0 ? options_.first_frame_intermediate_poses : options_.intermediate_poses) +
-        1;
-    for (int stage = 1; stage <= stages; ++stage) {
-      const double t = static_cast<double>(stage) / stages;
-      const VectorXd q_stage = (1.0 - t) * previous_q_ + t * q;
-      pose.set(q_stage);
-      poses = bone_poses(pose, bones_);
-      const std::vector<LinePath> lines = lines_at(q_stage, stage == stages ? frame_index : -1);
-      MuscleBinding::Targets targets = fine_.binding->targets(lines, poses);
-      if (coarse_) {
-        const MuscleBinding::Targets hull_targets = coarse_->binding->targets(lines, poses);
-        hull_solved = solve(*coarse_, hull_targets, poses);
-        targets = blend_with_hull(targets, embedding_->transfer(hull_solved.x),
-                                  fine_.binding->bone_blend());
-      }
-      solved = solve(fine_, targets, poses);
-      previous_poses_ = poses;
+    pose.set(q_stage);
+    poses_ = bone_poses(pose, bones_);
+    const std::vector<LinePath> lines =
+        lines_at(q_stage, last ? static_cast<int>(result_.frames.size()) : -1);
+    targets_ = fine_.binding->targets(lines, poses_);
+    hull_solved_ = DeformResult{};
+    if (coarse_) {
+      const MuscleBinding::Targets hull_targets = coarse_->binding->targets(lines, poses_);
+      hull_solved_ = solve(*coarse_, hull_targets, poses_);
+      targets_ = blend_with_hull(targets_, embedding_->transfer(hull_solved_.x),
+                                 fine_.binding->bone_blend());
     }
-    previous_q_ = q;
+    frame_seconds_ += seconds_since(start);
+  }
 
+  // The surface's solve in the prepared pose; `others`: every muscle's
+  // surface in this pose, to stay out of (nullptr: bones only).
+  void solve_stage(const MuscleSurfaces* others = nullptr,
+                   const std::vector<Contact>* pins = nullptr,
+                   const MuscleClearance* clearance = nullptr) {
+    const Clock::time_point start = Clock::now();
+    solved_ = solve(fine_, targets_, poses_, others, pins, clearance);
+    previous_poses_ = poses_;
+    frame_seconds_ += seconds_since(start);
+  }
+
+  void end_frame(const VectorXd& q) {
+    const Clock::time_point start = Clock::now();
+    previous_q_ = q;
     MuscleFrameMetrics metrics;
-    metrics.volume_error_percent = 100.0 * solved.volume_error;
-    const PenetrationMetrics penetration = fine_.contacts->measure(solved.x, poses);
+    metrics.volume_error_percent = 100.0 * solved_.volume_error;
+    const PenetrationMetrics penetration = fine_.contacts->measure(solved_.x, poses_);
     metrics.max_depth_mm = penetration.max_depth_mm;
     metrics.vertices_inside = penetration.vertices_inside;
     metrics.vertices_deeper = penetration.vertices_deeper;
     metrics.deepest_bone = penetration.deepest_bone;
     metrics.smoothness_change_percent =
-        100.0 * (bending(laplacian_, solved.x) / rest_bending_ - 1.0);
-    metrics.contacts = static_cast<int>(solved.contacts.size());
-    metrics.hull_contacts = static_cast<int>(hull_solved.contacts.size());
+        100.0 * (bending(laplacian_, solved_.x) / rest_bending_ - 1.0);
+    metrics.contacts = static_cast<int>(solved_.contacts.size());
+    metrics.hull_contacts = static_cast<int>(hull_solved_.contacts.size());
     metrics.path_contacts = path_contacts_;
-    metrics.contact_rounds = solved.contact_rounds;
-    metrics.volume_iterations = solved.volume_iterations;
-    metrics.converged = solved.converged && hull_solved.converged;
-    result_.positions.emplace_back(solved.x.cast<float>());
-    metrics.seconds = seconds_since(start);
+    metrics.contact_rounds = solved_.contact_rounds;
+    metrics.volume_iterations = solved_.volume_iterations;
+    metrics.converged = solved_.converged && hull_solved_.converged;
+    result_.positions.emplace_back(solved_.x.cast<float>());
+    metrics.seconds = frame_seconds_ + seconds_since(start);
+    frame_seconds_ = 0.0;
     result_.frames.push_back(metrics);
+  }
+
+  // The surface after the last solve (world, mm).
+  [[nodiscard]] const MatrixX3d& current() const { return solved_.x; }
+  [[nodiscard]] const Eigen::MatrixX3i& faces() const { return result_.rest.F; }
+  [[nodiscard]] const MatrixX3d& rest_vertices() const { return result_.rest.V; }
+
+  // Contacts between muscles: this muscle's index among the wrapped ones.
+  void set_index(int index) { index_ = index; }
+  void set_separation(double overlap_before_mm, double overlap_after_mm, double max_move_mm) {
+    result_.rest_overlap_before_mm = overlap_before_mm;
+    result_.rest_overlap_after_mm = overlap_after_mm;
+    result_.separation_move_mm = max_move_mm;
   }
 
   WrappedMuscle take() { return std::move(result_); }
@@ -364,16 +407,40 @@ class MuscleWrapper {
 
   // One volume-constrained solve of a level in this stage's bone poses, its
   // contacts carried from the previous stage and found inside the solve.
+  // With muscle contacts: `pins` (the shared contacts of this muscle, pinned
+  // from the start) and `others` (the surfaces they were found on, where new
+  // entries are looked for).
   DeformResult solve(Level& level, const MuscleBinding::Targets& targets,
-                     const std::vector<Isometry3d>& poses) {
+                     const std::vector<Isometry3d>& poses, const MuscleSurfaces* others = nullptr,
+                     const std::vector<Contact>* pins = nullptr,
+                     const MuscleClearance* clearance = nullptr) {
     std::vector<Contact> contacts = carried(level.carried, previous_poses_, poses);
+    if (!options_.bone_contacts) {
+      contacts.erase(std::remove_if(contacts.begin(), contacts.end(),
+                                    [](const Contact& c) { return c.obstacle >= 0; }),
+                     contacts.end());
+    }
+    if (pins != nullptr) {
+      std::vector<char> taken(static_cast<std::size_t>(level.deformer->rest().V.rows()), 0);
+      for (const Contact& contact : contacts) taken[static_cast<std::size_t>(contact.vertex)] = 1;
+      for (const Contact& pin : *pins) {
+        if (taken[static_cast<std::size_t>(pin.vertex)] == 0) contacts.push_back(pin);
+      }
+    }
     ContactQuery query;
-    if (options_.bone_contacts) {
+    if (options_.bone_contacts || others != nullptr) {
       query = [&](const MatrixX3d& x, const std::vector<char>& active) {
-        return level.contacts->find(x, poses, active);
+        std::vector<Contact> found;
+        if (options_.bone_contacts) found = level.contacts->find(x, poses, active);
+        if (others != nullptr) {
+          std::vector<char> taken = active;
+          for (const Contact& contact : found) taken[static_cast<std::size_t>(contact.vertex)] = 1;
+          const std::vector<Contact> entries =
+              muscle_entries(index_, x, taken, *others, options_.muscle_contact, clearance);
+          found.insert(found.end(), entries.begin(), entries.end());
+        }
+        return found;
       };
-    } else {
-      contacts.clear();
     }
     DeformResult solved =
         level.deformer->solve(targets.positions, targets.rotations, std::move(contacts), query);
@@ -391,6 +458,12 @@ class MuscleWrapper {
   std::vector<Isometry3d> rest_poses_;
   std::vector<Isometry3d> previous_poses_;
   VectorXd previous_q_;
+  std::vector<Isometry3d> poses_;    // bones in the prepared pose
+  MuscleBinding::Targets targets_;   // of the prepared pose
+  DeformResult solved_;              // the surface's last solve
+  DeformResult hull_solved_;         // the hull's last solve
+  double frame_seconds_ = 0.0;       // of the current frame so far
+  int index_ = -1;                   // among the wrapped muscles (muscle contacts)
   std::vector<LineRouter> routers_;  // per action line
   int path_contacts_ = 0;            // of the last lines_at
   Level fine_;
@@ -425,6 +498,17 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
     throw InvalidInputError("muscle wrapping: intermediate_poses must be >= 0");
   if (options.coarse_to_fine && options.hull_faces < 4)
     throw InvalidInputError("muscle wrapping: hull_faces must be >= 4 (a tetrahedron)");
+  if (options.muscle_contacts) {
+    const MuscleContactOptions& c = options.muscle_contact;
+    if (!(c.share >= 0.0 && c.share <= 1.0) || !(c.weight > 0.0) || !std::isfinite(c.weight) ||
+        !(c.reach_mm > 0.0) || !(c.tolerance_mm >= 0.0) || options.muscle_contact_rounds < 1 ||
+        options.separation_rounds < 1 || !(options.separation_weight > 0.0) ||
+        !std::isfinite(options.separation_weight)) {
+      throw InvalidInputError(
+          "muscle wrapping: muscle contacts need a share in [0, 1], weights > 0, reach > 0, "
+          "tolerance >= 0 and at least one round (muscle_contact_rounds, separation_rounds)");
+    }
+  }
   const std::vector<const atlas::Muscle*> muscles = selected_muscles(atlas, options.muscles);
   const motion::Skeleton skeleton = motion::skeleton_from_atlas(atlas);
   const VectorXd rest_q = rest_coordinates(atlas, skeleton);
@@ -446,28 +530,80 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
                                  static_cast<int>(std::max<std::size_t>(1, muscles.size())));
   result.threads = threads;
   result.muscles.resize(muscles.size());
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  auto work = [&] {
-    for (std::size_t m = next++; m < muscles.size(); m = next++) {
-      try {
-        MuscleWrapper wrapper(atlas, *muscles[m], atlas_dir, skeleton, bones, rest_q, options);
-        for (const VectorXd& q : frames) wrapper.frame(q);
-        result.muscles[m] = wrapper.take();
-      } catch (...) {
-        const std::lock_guard lock(failure_mutex);
-        if (!failure) failure = std::current_exception();
-        next = muscles.size();
-      }
+  if (!options.muscle_contacts) {
+    // Muscles independent: each runs through the whole motion on its own.
+    parallel_for(muscles.size(), threads, [&](std::size_t m) {
+      MuscleWrapper wrapper(atlas, *muscles[m], atlas_dir, skeleton, bones, rest_q, options);
+      for (const VectorXd& q : frames) wrapper.frame(q);
+      result.muscles[m] = wrapper.take();
+    });
+  } else {
+    // Pose by pose: every muscle solved with the bones, then again kept out
+    // of the others' surfaces of that first solve (same pose, so the common
+    // motion of the body cancels), each taking its share of an overlap.
+    // Overlaps the atlas has at rest are resolved once, first.
+    std::vector<mesh::IndexedMesh> surfaces(muscles.size());
+    parallel_for(muscles.size(), threads, [&](std::size_t m) {
+      surfaces[m] = wrapping_surface(*muscles[m], atlas_dir, options.target_faces);
+    });
+    SeparationOptions separation_options;
+    separation_options.contact = options.muscle_contact;
+    separation_options.contact.weight = options.separation_weight;
+    separation_options.max_rounds = options.separation_rounds;
+    separation_options.deformer = options.deformer;
+    separation_options.bone_contacts = options.contacts;
+    const MuscleSeparation separation = separate_muscles(
+        surfaces, options.bone_contacts ? bones.surfaces : std::vector<PosableBone>{},
+        separation_options, threads);
+    result.separation_seconds = separation.seconds;
+    result.separation_rounds = separation.rounds;
+    std::vector<std::unique_ptr<MuscleWrapper>> wrappers(muscles.size());
+    parallel_for(muscles.size(), threads, [&](std::size_t m) {
+      const mesh::IndexedMesh separated{separation.positions[m], surfaces[m].F};
+      wrappers[m] = std::make_unique<MuscleWrapper>(atlas, *muscles[m], atlas_dir, skeleton, bones,
+                                                    rest_q, options, &separated);
+      wrappers[m]->set_separation(separation.overlap_before_mm[m], separation.overlap_after_mm[m],
+                                  separation.max_move_mm[m]);
+    });
+    std::vector<const Eigen::MatrixX3i*> faces;
+    for (std::size_t m = 0; m < muscles.size(); ++m) {
+      wrappers[m]->set_index(static_cast<int>(m));
+      faces.push_back(&wrappers[m]->faces());
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
-  if (failure) std::rethrow_exception(failure);
-  if (options.muscle_penetration && result.muscles.size() > 1) {
+    for (const VectorXd& q : frames) {
+      const int stages = wrappers.front()->stages();
+      for (int stage = 1; stage <= stages; ++stage) {
+        const VectorXd q_stage = wrappers.front()->stage_coordinates(q, stage);
+        parallel_for(muscles.size(), threads, [&](std::size_t m) {
+          wrappers[m]->prepare_stage(q_stage, stage == stages);
+          wrappers[m]->solve_stage();
+        });
+        // Rounds of shared contacts, each found on the last round's
+        // surfaces and added to the pins of the rounds before.
+        MusclePins pins(muscles.size());
+        for (int round = 0; round < options.muscle_contact_rounds; ++round) {
+          std::vector<MatrixX3d> positions;
+          for (const std::unique_ptr<MuscleWrapper>& wrapper : wrappers)
+            positions.push_back(wrapper->current());
+          const MuscleSurfaces posed(positions, faces, threads);
+          MuscleContactOptions round_contact = options.muscle_contact;
+          round_contact.share =
+              round_share(round_contact.share, round, options.muscle_contact_rounds);
+          std::vector<MuscleClearance> clearances;
+          if (!pins.add(
+                  shared_muscle_contacts(positions, posed, round_contact, threads, &clearances)))
+            break;
+          parallel_for(muscles.size(), threads, [&](std::size_t m) {
+            const std::vector<Contact> own = pins.of(m);
+            wrappers[m]->solve_stage(&posed, &own, &clearances[m]);
+          });
+        }
+      }
+      parallel_for(muscles.size(), threads, [&](std::size_t m) { wrappers[m]->end_frame(q); });
+    }
+    for (std::size_t m = 0; m < muscles.size(); ++m) result.muscles[m] = wrappers[m]->take();
+  }
+  if ((options.muscle_penetration || options.muscle_contacts) && result.muscles.size() > 1) {
     const Clock::time_point measuring = Clock::now();
     measure_muscle_penetration(result, options.contacts.tolerance_mm, threads);
     result.muscle_penetration = true;

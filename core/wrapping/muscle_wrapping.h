@@ -30,6 +30,7 @@
 #include "core/wrapping/line_router.h"
 #include "core/wrapping/muscle_binding.h"
 #include "core/wrapping/muscle_hulls.h"
+#include "core/wrapping/muscle_penetration.h"
 #include "core/wrapping/volume_deformer.h"
 
 namespace mmm::wrapping {
@@ -42,6 +43,20 @@ struct MuscleWrappingOptions {
   // about as much again as the wrapping (every pair of touching muscles,
   // every frame).
   bool muscle_penetration = false;
+  // Impenetrability between muscles (muscle_separation.h,
+  // muscle_penetration.h). The overlaps the atlas has at rest are resolved
+  // first, once (the separated surfaces become the rest); then, per pose,
+  // every muscle is solved with the bones alone, and again in
+  // `muscle_contact_rounds` rounds with the shared contacts of the previous
+  // solve pinned (two overlapping muscles meet between their surfaces) and new
+  // entries into the others found inside the iterations. The muscles go pose
+  // by pose together (frame-major). Implies the muscle_penetration metric.
+  bool muscle_contacts = false;
+  MuscleContactOptions muscle_contact;
+  int muscle_contact_rounds = 2;  // >= 1
+  // Separation at rest: firmer pins than in motion, more rounds.
+  double separation_weight = 1e3;
+  int separation_rounds = 12;
   int intermediate_poses = 0;  // >= 0, between consecutive frames
   // Between the rest pose and the first frame, usually far apart: a vertex
   // driven deep into a bone in one step is projected out across a crowd of
@@ -118,6 +133,12 @@ struct WrappedMuscle {
   double hull_max_offset_mm = 0.0;
   double rest_volume_mm3 = 0.0;
   PenetrationMetrics rest_penetration;  // of the rest surface in the rest pose
+  // With muscle contacts (muscle_separation.h): the deepest vertex inside
+  // another muscle in the atlas at rest, after separating, and the largest
+  // move of the separation (mm); `rest` is the separated surface.
+  double rest_overlap_before_mm = 0.0;
+  double rest_overlap_after_mm = 0.0;
+  double separation_move_mm = 0.0;
 };
 
 struct MuscleWrapping {
@@ -130,6 +151,8 @@ struct MuscleWrapping {
   int threads = 1;
   bool muscle_penetration = false;          // measured (options.muscle_penetration)
   double muscle_penetration_seconds = 0.0;  // of that measurement (included in seconds)
+  double separation_seconds = 0.0;          // muscle contacts: separating at rest (included)
+  int separation_rounds = 0;
 };
 
 // atlas + its folder (meshes), a motion fused on a skeleton of this atlas

@@ -154,7 +154,8 @@ class ContactSolver {
     for (Eigen::Index i = 0; i < k; ++i)
       S.row(i) = Z_.row(contacts_[static_cast<std::size_t>(i)].vertex);
     S = 0.5 * (S + S.transpose()).eval();
-    S.diagonal().array() += 1.0 / state_.options.contact_weight;
+    for (Eigen::Index i = 0; i < k; ++i)
+      S(i, i) += 1.0 / weight(contacts_[static_cast<std::size_t>(i)]);
     capacitance_.compute(S);
   }
 
@@ -173,7 +174,7 @@ class ContactSolver {
   [[nodiscard]] MatrixX3d pull() const {
     MatrixX3d result = MatrixX3d::Zero(n_, 3);
     for (const Contact& contact : contacts_) {
-      result.row(contact.vertex) += state_.options.contact_weight * contact.target.transpose();
+      result.row(contact.vertex) += weight(contact) * contact.target.transpose();
     }
     return result;
   }
@@ -181,10 +182,14 @@ class ContactSolver {
   [[nodiscard]] const std::vector<Contact>& contacts() const { return contacts_; }
 
  private:
+  [[nodiscard]] double weight(const Contact& contact) const {
+    return contact.weight > 0.0 ? contact.weight : state_.options.contact_weight;
+  }
+
   void refactor() {
     SparseMatrix matrix = state_.matrix;
     for (const Contact& contact : contacts_)
-      matrix.coeffRef(contact.vertex, contact.vertex) += state_.options.contact_weight;
+      matrix.coeffRef(contact.vertex, contact.vertex) += weight(contact);
     if (!state_.contact_pattern_analysed) {
       state_.contact_factor.analyzePattern(matrix);
       state_.contact_pattern_analysed = true;
@@ -224,9 +229,11 @@ DeformResult VolumeDeformer::solve(const MatrixX3d& targets,
   auto accept = [&](std::vector<Contact>& candidates) {
     std::vector<Contact> fresh;
     for (const Contact& contact : candidates) {
-      if (contact.vertex < 0 || contact.vertex >= n || !contact.target.allFinite()) {
+      if (contact.vertex < 0 || contact.vertex >= n || !contact.target.allFinite() ||
+          !(contact.weight >= 0.0 && std::isfinite(contact.weight))) {
         throw InvalidInputError("volume deformer: contact at vertex " +
-                                std::to_string(contact.vertex) + " is out of range or not finite");
+                                std::to_string(contact.vertex) +
+                                " is out of range or not finite, or its weight is negative");
       }
       auto& flag = active[static_cast<std::size_t>(contact.vertex)];
       if (flag == 0) {

@@ -58,7 +58,8 @@ struct DeformerOptions {
 struct Contact {
   int vertex = -1;
   Eigen::Vector3d target = Eigen::Vector3d::Zero();
-  int obstacle = -1;  // what it entered, for the caller (e.g. a bone index); not used here
+  int obstacle = -1;    // what it entered, for the caller (e.g. a bone index); not used here
+  double weight = 0.0;  // > 0: its own pinning weight; 0: DeformerOptions::contact_weight
 };
 
 // Called with the current positions and a flag per vertex (1: already a
