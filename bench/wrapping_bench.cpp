@@ -158,6 +158,9 @@ struct WalkSummary {
   int vertex_frames_deeper = 0;
   double median_ms = 0.0;
   double seconds = 0.0;
+  bool muscle_penetration = false;  // measured
+  double max_muscle_depth_mm = 0.0;
+  int muscle_vertex_frames_deeper = 0;
 };
 
 WalkSummary summarise_walk(const wrapping::MuscleWrapping& wrapped) {
@@ -171,10 +174,13 @@ WalkSummary summarise_walk(const wrapping::MuscleWrapping& wrapped) {
     walk.max_bending_percent =
         std::max(walk.max_bending_percent, summary.max_smoothness_change_percent);
     walk.vertex_frames_deeper += summary.vertex_frames_deeper;
+    walk.max_muscle_depth_mm = std::max(walk.max_muscle_depth_mm, summary.max_muscle_depth_mm);
+    walk.muscle_vertex_frames_deeper += summary.muscle_vertex_frames_deeper;
     all_ms.insert(all_ms.end(), summary.ms_per_frame.begin(), summary.ms_per_frame.end());
   }
   walk.median_ms = wrapping::median(all_ms);
   walk.seconds = wrapped.seconds - wrapped.muscle_penetration_seconds;  // the wrapping itself
+  walk.muscle_penetration = wrapped.muscle_penetration;
   return walk;
 }
 
@@ -184,28 +190,38 @@ nlohmann::json write_variants_table(std::ostringstream& out, const WalkSummary& 
     std::string name;
     wrapping::MuscleWrappingOptions options;
   };
-  std::vector<Variant> variants(2);
+  std::vector<Variant> variants(3);
   variants[0].name = "direct (no hull)";
   variants[0].options.coarse_to_fine = false;
   variants[1].name = "global paths";
   variants[1].options.routing.method = wrapping::PathMethod::kGlobal;
+  variants[2].name = "muscle contacts";
+  variants[2].options.muscle_contacts = true;
   out << "\nvariants over the same walk\n"
       << std::left << std::setw(26) << "variant" << std::setw(14) << "|vol err| %" << std::setw(12)
       << "depth mm" << std::setw(14) << "max bending %" << std::setw(12) << "median ms"
-      << "whole walk s\n";
+      << std::setw(14) << "whole walk s"
+      << "in other muscles mm / vertex-frames deeper\n";
   nlohmann::json rows = nlohmann::json::array();
   const auto row = [&](const std::string& name, const WalkSummary& walk) {
     out << std::setw(26) << name << std::setw(14) << std::scientific << std::setprecision(1)
         << walk.max_volume_percent << std::fixed << std::setw(12) << std::setprecision(2)
         << walk.max_depth_mm << std::setw(14) << std::setprecision(0) << walk.max_bending_percent
-        << std::setw(12) << std::setprecision(1) << walk.median_ms << walk.seconds << "\n";
+        << std::setw(12) << std::setprecision(1) << walk.median_ms << std::setw(14) << walk.seconds
+        << (walk.muscle_penetration ? std::to_string(walk.max_muscle_depth_mm).substr(0, 4) +
+                                          " / " + std::to_string(walk.muscle_vertex_frames_deeper)
+                                    : std::string("-"))
+        << "\n";
     rows.push_back({{"variant", name},
                     {"max_abs_volume_error_percent", walk.max_volume_percent},
                     {"max_depth_mm", walk.max_depth_mm},
                     {"max_bending_change_percent", walk.max_bending_percent},
                     {"vertex_frames_deeper_than_tolerance", walk.vertex_frames_deeper},
                     {"median_ms_per_muscle_frame", walk.median_ms},
-                    {"whole_walk_s", walk.seconds}});
+                    {"whole_walk_s", walk.seconds},
+                    {"muscle_penetration_measured", walk.muscle_penetration},
+                    {"max_depth_in_other_muscles_mm", walk.max_muscle_depth_mm},
+                    {"vertex_frames_deeper_in_other_muscles", walk.muscle_vertex_frames_deeper}});
   };
   row("coarse to fine (default)", baseline);
   for (const Variant& variant : variants) {

@@ -36,8 +36,31 @@ struct ToyLegAndWalk {
   workflow::ArtifactRef motion;
 };
 
-ToyLegAndWalk toy_leg_and_walk(test::NodeHarness& harness, double end_time) {
+// A second vastus beside the first, overlapping it by `overlap` mm at rest.
+void add_neighbour(mmm::test::ToyLeg& leg, double overlap) {
+  atlas::Muscle neighbour = leg.atlas.muscles.front();
+  const std::string first = neighbour.name;
+  neighbour.name = "vastus_b_r";
+  const Eigen::Vector3d shift(20.0 - overlap, 0, 0);
+  for (atlas::MeshLevel& level : neighbour.meshes) {
+    level.file = "meshes/vastus_b_r/" + level.level + ".ply";
+    mesh::IndexedMesh moved = leg.meshes.at(first).at(level.level);
+    moved.V.rowwise() += shift.transpose();
+    leg.meshes[neighbour.name][level.level] = moved;
+  }
+  for (atlas::ActionLine& line : neighbour.action_lines) {
+    line.name = neighbour.name;
+    for (atlas::PathPoint& point : line.points) point.position += shift;
+  }
+  for (atlas::AttachmentArea& area : neighbour.origins) area.centroid += shift;
+  neighbour.wrap_obstacles.clear();
+  leg.atlas.muscles.push_back(neighbour);
+}
+
+ToyLegAndWalk toy_leg_and_walk(test::NodeHarness& harness, double end_time,
+                               double neighbour_overlap = -1.0) {
   ToyLegAndWalk result{mmm::test::toy_leg(), {}, {}};
+  if (neighbour_overlap >= 0.0) add_neighbour(result.leg, neighbour_overlap);
   for (const auto& [name, x] : {std::pair{"R.ASIS", 150.0}, {"L.ASIS", -60.0}}) {
     result.leg.atlas.markers.push_back({name, "pelvis", Eigen::Vector3d(x, 30, 20), true});
   }
@@ -124,6 +147,44 @@ TEST(WrapMusclesNodeTest, StoredHullsAreReusedWhileTheSurfaceAndFaceCountMatch) 
     warned =
         warned || harness.log()[i].find("give build_hulls the same atlas") != std::string::npos;
   EXPECT_TRUE(warned);
+}
+
+TEST(WrapMusclesNodeTest, WithMuscleContactsOverlappingMusclesAreSeparatedAndKeptApart) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.6, 3.0);
+  const auto outputs = harness.run<WrapMuscles>({{"atlas", toy.atlas}, {"motion", toy.motion}},
+                                                {{"muscle_contacts", true}});
+  const nlohmann::json report =
+      nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+  EXPECT_TRUE(report["muscle_contacts"].get<bool>());
+  EXPECT_TRUE(report["muscle_penetration_measured"].get<bool>());
+  ASSERT_EQ(report["muscles"].size(), 2U);
+  for (const nlohmann::json& muscle : report["muscles"]) {
+    EXPECT_NEAR(muscle["separation"]["overlap_at_rest_mm"].get<double>(), 3.0, 0.3);
+    EXPECT_LT(muscle["separation"]["overlap_after_mm"].get<double>(), 0.3);
+    EXPECT_GT(muscle["separation"]["max_move_mm"].get<double>(), 0.5);
+  }
+  EXPECT_GE(report["separation_rounds"].get<int>(), 1);
+  EXPECT_LT(report["max_depth_in_other_muscles_mm"].get<double>(), 1.0);
+  EXPECT_LT(report["max_abs_volume_error_percent"].get<double>(), 1e-5);
+  EXPECT_LE(report["max_depth_mm"].get<double>(), 0.1 + 1e-9);
+  EXPECT_EQ(report["unconverged_muscle_frames"], 0);
+  // The metrics CSV has the penetration into the other muscles filled.
+  std::istringstream metrics(mmm::test::read_text(outputs.at("metrics").path));
+  std::string header;
+  std::string row;
+  std::getline(metrics, header);
+  std::getline(metrics, row);
+  ASSERT_EQ(header.rfind("muscle,frame,time_s,volume_error_percent,max_depth_mm,vertices_inside,"
+                         "vertices_deeper,deepest_bone,muscle_depth_mm,",
+                         0),
+            0U);
+  std::vector<std::string> fields;
+  std::istringstream cells(row);
+  for (std::string cell; std::getline(cells, cell, ',');) fields.push_back(cell);
+  ASSERT_GT(fields.size(), 8U);
+  EXPECT_FALSE(fields[8].empty()) << row;
+  EXPECT_LT(std::stod(fields[8]), 1.0) << row;
 }
 
 TEST(WrapMusclesNodeTest, AMotionOfAnOpenSimModelIsRefusedWithAHint) {

@@ -139,6 +139,25 @@ TEST(VolumeDeformerTest, StartingContactsArePinnedFromTheFirstSolve) {
   EXPECT_LT(std::abs(result.volume_error), 1e-9);
 }
 
+TEST(VolumeDeformerTest, AContactsOwnWeightHoldsItMoreOrLessFirmly) {
+  const mesh::IndexedMesh rest = sphere();
+  const VolumeDeformer deformer(rest);
+  const Vector3d pinned = rest.V.row(0).transpose() + Vector3d(0, 0, 4.0);
+  const auto reached = [&](double weight) {
+    const DeformResult result = deformer.solve(rest.V, {}, {{0, pinned, -1, weight}});
+    EXPECT_LT(std::abs(result.volume_error), 1e-9);
+    return 1.0 - (result.x.row(0).transpose() - pinned).norm() / 4.0;
+  };
+  const double by_default = reached(0.0);  // DeformerOptions::contact_weight
+  EXPECT_GT(by_default, 0.98);
+  EXPECT_DOUBLE_EQ(reached(DeformerOptions{}.contact_weight), by_default);
+  const double soft = reached(1e-3);
+  EXPECT_LT(soft, 0.5 * by_default);
+  EXPECT_GT(soft, 0.0);
+  EXPECT_LT(soft, reached(1.0));
+  EXPECT_THROW((void)deformer.solve(rest.V, {}, {{0, pinned, -1, -1.0}}), InvalidInputError);
+}
+
 TEST(VolumeDeformerTest, BadInputIsRefusedWithTheReason) {
   const mesh::IndexedMesh rest = sphere();
   mesh::IndexedMesh inward = rest;
