@@ -1,14 +1,18 @@
 #pragma once
-// How far wrapped muscles run into each other: the muscle-muscle penetration
-// metric of muscle wrapping, measured after every muscle has been solved for
-// a frame (muscles are wrapped independently; nothing here moves a vertex).
+// Muscles running into each other: the muscle-muscle penetration metric of
+// muscle wrapping, and the contacts that keep muscles apart.
 //
-// Segmented atlases overlap a little where two muscles meet (the Visible
-// Human surfaces were traced one by one), so the metric is the penetration
-// the motion adds: a vertex's depth inside another muscle minus its depth
-// inside that muscle at rest (0 where it was outside). Inside tests by
-// winding number, depths by exact closest point (mesh::SignedDistance); only
-// muscles whose boxes meet are compared.
+// The metric is measured after every muscle has been solved for a frame.
+// Segmented atlases overlap where two muscles were traced one by one (the
+// Visible Human surfaces), so it is the penetration the motion adds: a
+// vertex's depth inside another muscle minus its depth inside that muscle at
+// rest (0 where it was outside). Inside tests by winding number, depths by
+// exact closest point (mesh::SignedDistance); only muscles whose boxes meet
+// are compared.
+//
+// The contacts (shared_muscle_contacts, muscle_entries) pin vertices of
+// overlapping muscles for the volume-preserving solve (volume_deformer.h),
+// like bone contacts but shared: both sides give way, each by its share.
 
 #include <Eigen/Geometry>
 #include <map>
