@@ -583,6 +583,7 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
         MusclePins pins(muscles.size());
         for (int round = 0; round < options.muscle_contact_rounds; ++round) {
           std::vector<MatrixX3d> positions;
+          positions.reserve(wrappers.size());
           for (const std::unique_ptr<MuscleWrapper>& wrapper : wrappers)
             positions.push_back(wrapper->current());
           const MuscleSurfaces posed(positions, faces, threads);

@@ -209,7 +209,7 @@ TEST(MuscleContactsTest, NewEntriesAreTheSameWithTheClearanceShortcut) {
   const MuscleContactOptions options;
   const std::vector<Contact> full = muscle_entries(0, grown, none_active, found_on, options);
   const std::vector<Contact> pruned =
-      muscle_entries(0, grown, none_active, found_on, options, &clearances[0]);
+      muscle_entries(0, grown, none_active, found_on, options, &clearances.front());
   ASSERT_FALSE(full.empty());
   ASSERT_EQ(full.size(), pruned.size());
   for (std::size_t i = 0; i < full.size(); ++i) {

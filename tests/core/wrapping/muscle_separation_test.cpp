@@ -22,6 +22,7 @@ mesh::IndexedMesh sphere_at(const Eigen::Vector3d& centre, double radius = 10.0)
 
 double deepest(const MuscleSeparation& separation, const std::vector<mesh::IndexedMesh>& surfaces) {
   std::vector<const Eigen::MatrixX3i*> faces;
+  faces.reserve(surfaces.size());
   for (const mesh::IndexedMesh& surface : surfaces) faces.push_back(&surface.F);
   const MuscleSurfaces now(separation.positions, faces, 1);
   double depth = 0.0;
