@@ -19,6 +19,13 @@ Eigen::AlignedBox3d bounds(const Eigen::MatrixX3d& x) {
   return box;
 }
 
+Eigen::Vector3d face_normal(const Eigen::MatrixX3d& x, const Eigen::MatrixX3i& faces, int f) {
+  const Eigen::Vector3d a = x.row(faces(f, 0)).transpose();
+  const Eigen::Vector3d b = x.row(faces(f, 1)).transpose();
+  const Eigen::Vector3d c = x.row(faces(f, 2)).transpose();
+  return (b - a).cross(c - a).normalized();
+}
+
 // Whether p, whose nearest point of a closed surface is `closest`, is inside
 // it: when that point is inside a face, by the side of the face p is on
 // (exact); on an edge or a corner, by the winding number.
@@ -26,12 +33,8 @@ bool inside(const mesh::SignedDistance& surface, const mesh::AabbTree::ClosestPo
             const Eigen::Vector3d& p) {
   constexpr double kInterior = 1e-6;
   if (closest.barycentric.minCoeff() > kInterior) {
-    const Eigen::MatrixX3d& vertices = surface.tree().mesh().V;
-    const Eigen::MatrixX3i& faces = surface.tree().mesh().F;
-    const Eigen::Vector3d a = vertices.row(faces(closest.face, 0)).transpose();
-    const Eigen::Vector3d b = vertices.row(faces(closest.face, 1)).transpose();
-    const Eigen::Vector3d c = vertices.row(faces(closest.face, 2)).transpose();
-    return (p - closest.point).dot((b - a).cross(c - a)) < 0.0;
+    const mesh::IndexedMesh& mesh = surface.tree().mesh();
+    return (p - closest.point).dot(face_normal(mesh.V, mesh.F, closest.face)) < 0.0;
   }
   return surface.winding().is_inside(p);
 }
@@ -88,13 +91,6 @@ void for_each_inside(int self, const Eigen::MatrixX3d& x, const MuscleSurfaces& 
       visit(static_cast<int>(n), v, std::sqrt(closest.squared_distance), closest);
     }
   }
-}
-
-Eigen::Vector3d face_normal(const Eigen::MatrixX3d& x, const Eigen::MatrixX3i& faces, int f) {
-  const Eigen::Vector3d a = x.row(faces(f, 0)).transpose();
-  const Eigen::Vector3d b = x.row(faces(f, 1)).transpose();
-  const Eigen::Vector3d c = x.row(faces(f, 2)).transpose();
-  return (b - a).cross(c - a).normalized();
 }
 
 double rest_depth(const RestOverlap& rest, int n, Eigen::Index v) {

@@ -39,9 +39,9 @@ MuscleSeparation separate_muscles(const std::vector<mesh::IndexedMesh>& surfaces
     result.positions.push_back(surface.V);
   }
   const double tolerance = options.contact.tolerance_mm;
-  result.overlap_before_mm = deepest_overlaps(
-      result.positions, MuscleSurfaces(result.positions, faces, threads), tolerance, threads);
-  result.overlap_after_mm = result.overlap_before_mm;
+  // The surfaces as they stand: measured, then the next round's obstacles.
+  auto now = std::make_unique<MuscleSurfaces>(result.positions, faces, threads);
+  result.overlap_before_mm = deepest_overlaps(result.positions, *now, tolerance, threads);
 
   // Deformers and bone contacts only for the muscles that get pins (made
   // when they first do): the others stay exactly as they are.
@@ -50,10 +50,9 @@ MuscleSeparation separate_muscles(const std::vector<mesh::IndexedMesh>& surfaces
   const std::vector<Eigen::Isometry3d> at_rest(bones.size(), Eigen::Isometry3d::Identity());
   MusclePins pins(muscles);
   for (int round = 0; round < options.max_rounds; ++round) {
-    const MuscleSurfaces now(result.positions, faces, threads);
     MuscleContactOptions round_contact = options.contact;
     round_contact.share = round_share(round_contact.share, round, options.max_rounds);
-    if (!pins.add(shared_muscle_contacts(result.positions, now, round_contact, threads))) break;
+    if (!pins.add(shared_muscle_contacts(result.positions, *now, round_contact, threads))) break;
     result.rounds = round + 1;
     parallel_for(muscles, threads, [&](std::size_t m) {
       if (pins.empty(m)) return;
@@ -72,9 +71,9 @@ MuscleSeparation separate_muscles(const std::vector<mesh::IndexedMesh>& surfaces
       }
       result.positions[m] = deformers[m]->solve(surfaces[m].V, {}, pins.of(m), query).x;
     });
+    now = std::make_unique<MuscleSurfaces>(result.positions, faces, threads);
   }
-  result.overlap_after_mm = deepest_overlaps(
-      result.positions, MuscleSurfaces(result.positions, faces, threads), tolerance, threads);
+  result.overlap_after_mm = deepest_overlaps(result.positions, *now, tolerance, threads);
   for (std::size_t m = 0; m < muscles; ++m) {
     result.max_move_mm.push_back((result.positions[m] - surfaces[m].V).rowwise().norm().maxCoeff());
     const double rest = enclosed_volume(surfaces[m].V, surfaces[m].F);
