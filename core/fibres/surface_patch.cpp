@@ -1,12 +1,14 @@
 #include "core/fibres/surface_patch.h"
 
 #include <string>
+#include <vector>
 
 #include "core/errors.h"
+#include "core/opensim/opensim_function.h"
 
 namespace mmm::fibres {
 
-Eigen::MatrixXd natural_cubic_spline(const Eigen::MatrixXd& points, int count) {
+Eigen::MatrixXd cubic_spline(const Eigen::MatrixXd& points, int count) {
   const Eigen::Index k = points.rows();
   if (k < 2 || points.cols() < 3 || count < 2) {
     throw InvalidInputError(
@@ -26,44 +28,20 @@ Eigen::MatrixXd natural_cubic_spline(const Eigen::MatrixXd& points, int count) {
     u[i] = u[i - 1] + step;
   }
   u /= u[k - 1];
-  // Second derivatives M (natural: M_0 = M_k-1 = 0) from the tridiagonal
-  // system h_i-1 M_i-1 + 2 (h_i-1 + h_i) M_i + h_i M_i+1 = 6 (slope_i - slope_i-1).
-  Eigen::MatrixXd second = Eigen::MatrixXd::Zero(k, 3);
-  if (k > 2) {
-    const Eigen::Index m = k - 2;
-    Eigen::VectorXd diagonal(m);
-    Eigen::VectorXd upper(m);
-    Eigen::MatrixXd rhs(m, 3);
-    for (Eigen::Index i = 1; i <= m; ++i) {
-      const double before = u[i] - u[i - 1];
-      const double after = u[i + 1] - u[i];
-      diagonal[i - 1] = 2.0 * (before + after);
-      upper[i - 1] = after;
-      rhs.row(i - 1) =
-          6.0 * ((p.row(i + 1) - p.row(i)) / after - (p.row(i) - p.row(i - 1)) / before);
-    }
-    // Thomas algorithm (symmetric: the lower diagonal equals the upper one shifted).
-    for (Eigen::Index i = 1; i < m; ++i) {
-      const double factor = upper[i - 1] / diagonal[i - 1];
-      diagonal[i] -= factor * upper[i - 1];
-      rhs.row(i) -= factor * rhs.row(i - 1);
-    }
-    second.row(m) = rhs.row(m - 1) / diagonal[m - 1];
-    for (Eigen::Index i = m - 2; i >= 0; --i)
-      second.row(i + 1) = (rhs.row(i) - upper[i] * second.row(i + 2)) / diagonal[i];
+  // Per coordinate, the interpolating C2 cubic spline the project already
+  // has for OpenSim's SimmSpline (its end conditions reproduce cubics).
+  const std::vector<double> knots(u.data(), u.data() + u.size());
+  std::vector<opensim::SimmSpline> coordinates;
+  coordinates.reserve(3);
+  for (int c = 0; c < 3; ++c) {
+    const Eigen::VectorXd column = p.col(c);
+    coordinates.emplace_back(knots, std::vector<double>(column.data(), column.data() + k));
   }
   Eigen::MatrixXd samples(count, 3);
-  Eigen::Index segment = 0;
   for (int s = 0; s < count; ++s) {
     const double x = static_cast<double>(s) / (count - 1);
-    while (segment + 2 < k && x > u[segment + 1]) ++segment;
-    const double h = u[segment + 1] - u[segment];
-    const double a = (u[segment + 1] - x) / h;
-    const double b = (x - u[segment]) / h;
-    samples.row(s) =
-        a * p.row(segment) + b * p.row(segment + 1) +
-        ((a * a * a - a) * second.row(segment) + (b * b * b - b) * second.row(segment + 1)) *
-            (h * h / 6.0);
+    for (int c = 0; c < 3; ++c)
+      samples(s, c) = coordinates[static_cast<std::size_t>(c)].evaluate(x);
   }
   return samples;
 }
@@ -88,8 +66,7 @@ mesh::IndexedMesh fibre_surface_patch(const std::vector<TPolynomial>& fibres, in
   for (int i = 0; i < along; ++i) {
     for (std::size_t f = 0; f < fibres.size(); ++f)
       row.row(static_cast<Eigen::Index>(f)) = sampled[f].row(i).leftCols<3>();
-    patch.V.middleRows(static_cast<Eigen::Index>(i) * across, across) =
-        natural_cubic_spline(row, across);
+    patch.V.middleRows(static_cast<Eigen::Index>(i) * across, across) = cubic_spline(row, across);
   }
   patch.F.resize(2 * static_cast<Eigen::Index>(along - 1) * (across - 1), 3);
   Eigen::Index f = 0;

@@ -1,7 +1,7 @@
 #pragma once
 // A muscle's surface patch from a few fibres (the second reference
 // document): each fibre, a t-polynomial, sampled at n equidistant t; at each
-// t, a natural cubic spline through the fibres' points (in fibre order,
+// t, an interpolating cubic spline through the fibres' points (in fibre order,
 // parameterised by chord length) sampled at m points; the grid triangulated.
 
 #include <Eigen/Core>
@@ -12,12 +12,13 @@
 
 namespace mmm::fibres {
 
-// `count` (>= 2) points along the natural cubic spline through `points`
-// (K >= 2 rows, x y z in the first three columns), at equal steps of its
-// chord-length parameter (two points: the straight segment). Throws
+// `count` (>= 2) points along the interpolating C2 cubic spline through
+// `points` (K >= 2 rows, x y z in the first three columns; opensim::SimmSpline
+// per coordinate, so cubics are reproduced, not "natural" ends), at equal
+// steps of its chord-length parameter (two points: the straight segment). Throws
 // InvalidInputError for too few points, repeated consecutive points or
 // non-finite values.
-Eigen::MatrixXd natural_cubic_spline(const Eigen::MatrixXd& points, int count);
+Eigen::MatrixXd cubic_spline(const Eigen::MatrixXd& points, int count);
 
 // The patch through `fibres` (>= 2, each of at least three dimensions; the
 // first three are used): `along` (>= 2) samples along each fibre, `across`

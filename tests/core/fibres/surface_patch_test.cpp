@@ -1,4 +1,4 @@
-// Surface patches from fibres: the natural cubic spline keeps collinear
+// Surface patches from fibres: the interpolating cubic spline keeps collinear
 // points on their line and follows a circular arc closely; a patch through
 // parallel straight fibres in a plane is that rectangle exactly, and one
 // through fibres on a cylinder stays on the cylinder.
@@ -30,7 +30,7 @@ TPolynomial straight(const Vector3d& a, const Vector3d& b) {
 TEST(SurfacePatchTest, ASplineThroughCollinearPointsStaysOnTheirLine) {
   MatrixXd points(4, 3);
   points << 0, 0, 0, 1, 2, 2, 4, 8, 8, 5, 10, 10;  // uneven steps along (1, 2, 2)
-  const MatrixXd samples = natural_cubic_spline(points, 16);
+  const MatrixXd samples = cubic_spline(points, 16);
   const Vector3d direction = Vector3d(1, 2, 2).normalized();
   for (Eigen::Index s = 0; s < samples.rows(); ++s) {
     const Vector3d p = samples.row(s).transpose();
@@ -46,12 +46,12 @@ TEST(SurfacePatchTest, ASplineThroughPointsOfACircularArcFollowsIt) {
     const double angle = 0.5 * std::numbers::pi * i / (k - 1);
     points.row(i) << 30 * std::cos(angle), 30 * std::sin(angle), 0;
   }
-  const MatrixXd samples = natural_cubic_spline(points, 91);
+  const MatrixXd samples = cubic_spline(points, 91);
   // Through every point (the knots fall on every 15th sample: equal chords).
   for (int i = 0; i < k; ++i)
     EXPECT_LT((samples.row(Eigen::Index{15} * i) - points.row(i)).norm(), 1e-9) << i;
-  // Off the arc by at most 0.1 mm near the ends, where a natural spline's
-  // zero curvature meets the circle's, and by under 0.01 mm in the middle.
+  // Off the arc by a small fraction of a millimetre, least in the middle
+  // (measured: 0.005 mm at most, 0.0002 mm in the middle).
   double worst = 0.0;
   double middle = 0.0;
   for (Eigen::Index s = 0; s < samples.rows(); ++s) {
@@ -93,7 +93,8 @@ TEST(SurfacePatchTest, FibresOnACylinderGiveAPatchOnTheCylinder) {
     fibres.push_back(straight(around, around + Vector3d(0, 0, 120)));
   }
   const mesh::IndexedMesh patch = fibre_surface_patch(fibres, 5, 61);
-  // On the cylinder up to the natural spline's end effect (as for the arc).
+  // On the cylinder, least away from the edges (measured: 0.061 mm at most,
+  // 0.0024 mm in the middle).
   double worst = 0.0;
   double middle = 0.0;
   for (Eigen::Index v = 0; v < patch.V.rows(); ++v) {
@@ -107,9 +108,9 @@ TEST(SurfacePatchTest, FibresOnACylinderGiveAPatchOnTheCylinder) {
 }
 
 TEST(SurfacePatchTest, BadInputIsRefused) {
-  EXPECT_THROW((void)natural_cubic_spline(MatrixXd::Zero(1, 3), 5), InvalidInputError);
-  EXPECT_THROW((void)natural_cubic_spline(MatrixXd::Zero(3, 3), 5), InvalidInputError);
-  EXPECT_THROW((void)natural_cubic_spline(MatrixXd::Random(3, 3), 1), InvalidInputError);
+  EXPECT_THROW((void)cubic_spline(MatrixXd::Zero(1, 3), 5), InvalidInputError);
+  EXPECT_THROW((void)cubic_spline(MatrixXd::Zero(3, 3), 5), InvalidInputError);
+  EXPECT_THROW((void)cubic_spline(MatrixXd::Random(3, 3), 1), InvalidInputError);
   const TPolynomial fibre = straight(Vector3d::Zero(), Vector3d(0, 0, 10));
   EXPECT_THROW((void)fibre_surface_patch({fibre}, 5, 5), InvalidInputError);
   EXPECT_THROW((void)fibre_surface_patch({fibre, fibre}, 1, 5), InvalidInputError);
