@@ -1,0 +1,62 @@
+#include "core/fibres/contour_stack.h"
+
+#include <optional>
+#include <string>
+
+#include "core/errors.h"
+#include "core/fibres/contour_map.h"
+#include "core/fibres/iso_lines.h"
+
+namespace mmm::fibres {
+
+ContourStack contour_stack(const mesh::IndexedMesh& surface, const Eigen::VectorXd& values,
+                           const std::vector<double>& levels, const Eigen::Vector3d& reference,
+                           int contour_points) {
+  std::vector<std::optional<Contour>> found(levels.size());
+  int closed = 0;
+  for (std::size_t k = 0; k < levels.size(); ++k) {
+    const Eigen::MatrixX3d loop = largest_loop(iso_lines(surface, values, levels[k]));
+    if (loop.rows() >= 3 && enclosed_area(loop) > 0.0) {
+      found[k] = consistent_contour(loop, vector_area(loop), reference, contour_points);
+      ++closed;
+    }
+  }
+  if (closed < 2) {
+    throw InvalidInputError("slicing: only " + std::to_string(closed) + " of " +
+                            std::to_string(levels.size()) +
+                            " levels cut the muscle in a closed loop; is the surface closed and "
+                            "do its attachment areas lie at its two ends?");
+  }
+  ContourStack stack;
+  for (std::size_t k = 0; k < levels.size(); ++k) {
+    if (found[k]) {
+      stack.contours.push_back(*found[k]);
+      continue;
+    }
+    ++stack.interpolated;
+    // The nearest closed levels below and above (or the one on one side).
+    std::optional<std::size_t> below;
+    std::optional<std::size_t> above;
+    for (std::size_t j = k; j-- > 0;) {
+      if (found[j]) {
+        below = j;
+        break;
+      }
+    }
+    for (std::size_t j = k + 1; j < levels.size(); ++j) {
+      if (found[j]) {
+        above = j;
+        break;
+      }
+    }
+    if (below && above) {
+      const double w = (levels[k] - levels[*below]) / (levels[*above] - levels[*below]);
+      stack.contours.push_back((1.0 - w) * *found[*below] + w * *found[*above]);
+    } else {
+      stack.contours.push_back(*found[below ? *below : *above]);
+    }
+  }
+  return stack;
+}
+
+}  // namespace mmm::fibres

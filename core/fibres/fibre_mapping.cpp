@@ -1,0 +1,206 @@
+#include "core/fibres/fibre_mapping.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "core/errors.h"
+#include "core/fibres/contour_map.h"
+#include "core/fibres/keep_inside.h"
+
+namespace mmm::fibres {
+
+using Eigen::Index;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+std::vector<Fibre> fibres_through_contours(const std::vector<Contour>& contours,
+                                           const std::vector<TemplateFibre>& templates) {
+  if (contours.size() < 2) {
+    throw InvalidInputError("fibres_through_contours: at least two contours are needed");
+  }
+  const Index points = contours.front().rows();
+  for (const Contour& contour : contours) {
+    if (contour.rows() != points) {
+      throw InvalidInputError("fibres_through_contours: contours of different point counts");
+    }
+  }
+  const auto levels = static_cast<Index>(contours.size());
+  std::vector<Fibre> fibres;
+  fibres.reserve(templates.size());
+  for (const TemplateFibre& fibre : templates) {
+    Fibre mapped(levels, 3);
+    for (Index k = 0; k < levels; ++k) {
+      const double s = static_cast<double>(k) / static_cast<double>(levels - 1);
+      const Vector2d uv = fibre.at(s).cwiseMax(0.0).cwiseMin(1.0);
+      const Eigen::RowVectorXd weights = square_mean_value_weights(uv, static_cast<int>(points));
+      mapped.row(k) = weights * contours[static_cast<std::size_t>(k)];
+    }
+    fibres.push_back(std::move(mapped));
+  }
+  return fibres;
+}
+
+namespace {
+
+// Coordinates in the cross-section plane, stretched over [0, 1]^2.
+Eigen::MatrixX2d unit_layout(const Eigen::MatrixX2d& plane) {
+  const Eigen::RowVector2d lo = plane.colwise().minCoeff();
+  const Eigen::RowVector2d span = (plane.colwise().maxCoeff() - lo).cwiseMax(1e-12);
+  return (plane.rowwise() - lo).array().rowwise() / span.array();
+}
+
+}  // namespace
+
+std::vector<int> match_ends(const Eigen::MatrixX3d& points, const MuscleAxes& axes,
+                            const std::vector<Vector2d>& ends) {
+  if (points.rows() == 0) {
+    throw InvalidInputError("match_ends: the attachment area has no points");
+  }
+  const Vector3d across = axes.axis.cross(axes.reference);
+  Eigen::MatrixX2d plane(points.rows(), 2);
+  plane.col(0) = points * axes.reference;
+  plane.col(1) = points * across;
+  const Eigen::MatrixX2d area = unit_layout(plane);
+  Eigen::MatrixX2d end_plane(static_cast<Index>(ends.size()), 2);
+  for (std::size_t i = 0; i < ends.size(); ++i) {
+    end_plane.row(static_cast<Index>(i)) = ends[i].transpose();
+  }
+  const Eigen::MatrixX2d wanted = ends.empty() ? end_plane : unit_layout(end_plane);
+  std::vector<int> chosen(ends.size(), 0);
+  for (Index i = 0; i < wanted.rows(); ++i) {
+    Index best = 0;
+    (area.rowwise() - wanted.row(i)).rowwise().squaredNorm().minCoeff(&best);
+    chosen[static_cast<std::size_t>(i)] = static_cast<int>(best);
+  }
+  return chosen;
+}
+
+namespace {
+
+// Points of the quadratic Bezier target -> control -> end, excluding `end`,
+// about `spacing` apart.
+std::vector<Vector3d> bridge(const Vector3d& target, const Vector3d& end,
+                             const Vector3d& direction_into_target, double spacing) {
+  const double gap = (target - end).norm();
+  if (gap < 1e-9) {
+    return {};
+  }
+  const Vector3d control = end + 0.5 * gap * direction_into_target;
+  const int steps = std::max(1, static_cast<int>(std::ceil(gap / std::max(spacing, 1e-9))));
+  std::vector<Vector3d> out;
+  for (int i = 0; i < steps; ++i) {
+    const double t = static_cast<double>(i) / steps;
+    const double r = 1.0 - t;
+    out.push_back(r * r * target + 2.0 * r * t * control + t * t * end);
+  }
+  return out;
+}
+
+}  // namespace
+
+Fibre extend_fibre(const Fibre& fibre, const Vector3d& origin_target,
+                   const Vector3d& insertion_target) {
+  const Index n = fibre.rows();
+  if (n < 2) {
+    throw InvalidInputError("extend_fibre: a fibre needs at least two points");
+  }
+  const double spacing = fibre_length(fibre) / static_cast<double>(n - 1);
+  const Vector3d first = fibre.row(0).transpose();
+  const Vector3d last = fibre.row(n - 1).transpose();
+  Vector3d back = first - fibre.row(1).transpose();  // direction out of the origin end
+  Vector3d ahead = last - fibre.row(n - 2).transpose();
+  back = back.norm() > 0.0 ? back.normalized() : Vector3d::Zero();
+  ahead = ahead.norm() > 0.0 ? ahead.normalized() : Vector3d::Zero();
+  const std::vector<Vector3d> head = bridge(origin_target, first, back, spacing);
+  std::vector<Vector3d> tail = bridge(insertion_target, last, ahead, spacing);
+  std::reverse(tail.begin(), tail.end());
+  Fibre out(static_cast<Index>(head.size() + tail.size()) + n, 3);
+  Index row = 0;
+  for (const Vector3d& p : head) {
+    out.row(row++) = p.transpose();
+  }
+  out.middleRows(row, n) = fibre;
+  row += n;
+  for (const Vector3d& p : tail) {
+    out.row(row++) = p.transpose();
+  }
+  return out;
+}
+
+std::vector<Fibre> finish_fibres(const std::vector<Fibre>& mapped,
+                                 const std::vector<TemplateFibre>& templates,
+                                 const Attachments& attachments, const MuscleAxes& axes,
+                                 const mesh::WindingNumber& inside,
+                                 const DecompositionOptions& options, int* moved_inside) {
+  std::vector<Vector2d> starts;
+  std::vector<Vector2d> ends;
+  for (const TemplateFibre& fibre : templates) {
+    starts.push_back(fibre.at(0.0));
+    ends.push_back(fibre.at(1.0));
+  }
+  const std::vector<int> origin_of = match_ends(attachments.origin, axes, starts);
+  const std::vector<int> insertion_of = match_ends(attachments.insertion, axes, ends);
+  std::vector<Fibre> fibres;
+  fibres.reserve(mapped.size());
+  for (std::size_t f = 0; f < mapped.size(); ++f) {
+    const Vector3d origin_target =
+        inside.tree().closest_point(attachments.origin.row(origin_of[f]).transpose()).point;
+    const Vector3d insertion_target =
+        inside.tree().closest_point(attachments.insertion.row(insertion_of[f]).transpose()).point;
+    Fibre whole = extend_fibre(mapped[f], origin_target, insertion_target);
+    smooth_fibre(whole, options.smoothing_passes);
+    fibres.push_back(resample_fibre(whole, options.segments));
+  }
+  const int moved = keep_inside(fibres, inside, kInsideMarginMm);
+  if (moved_inside != nullptr) {
+    *moved_inside = moved;
+  }
+  return fibres;
+}
+
+void smooth_fibre(Fibre& fibre, int passes) {
+  const Index n = fibre.rows();
+  for (int pass = 0; pass < passes && n > 2; ++pass) {
+    const Fibre before = fibre;
+    for (Index i = 1; i + 1 < n; ++i) {
+      fibre.row(i) = 0.5 * before.row(i) + 0.25 * (before.row(i - 1) + before.row(i + 1));
+    }
+  }
+}
+
+double fibre_length(const Fibre& fibre) {
+  double length = 0.0;
+  for (Index i = 1; i < fibre.rows(); ++i) {
+    length += (fibre.row(i) - fibre.row(i - 1)).norm();
+  }
+  return length;
+}
+
+Fibre resample_fibre(const Fibre& fibre, int segments) {
+  const Index n = fibre.rows();
+  if (n < 2 || segments < 1) {
+    throw InvalidInputError("resample_fibre: needs >= 2 points and >= 1 segment");
+  }
+  Eigen::VectorXd along(n);
+  along(0) = 0.0;
+  for (Index i = 1; i < n; ++i) {
+    along(i) = along(i - 1) + (fibre.row(i) - fibre.row(i - 1)).norm();
+  }
+  Fibre out(segments + 1, 3);
+  Index k = 0;
+  for (int j = 0; j <= segments; ++j) {
+    const double target = along(n - 1) * j / segments;
+    while (k + 2 < n && along(k + 1) < target) {
+      ++k;
+    }
+    const double span = along(k + 1) - along(k);
+    const double w = span > 0.0 ? std::clamp((target - along(k)) / span, 0.0, 1.0) : 0.0;
+    out.row(j) = (1.0 - w) * fibre.row(k) + w * fibre.row(k + 1);
+  }
+  return out;
+}
+
+}  // namespace mmm::fibres

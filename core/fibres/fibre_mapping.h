@@ -1,0 +1,60 @@
+#pragma once
+// The steps the contour-based decompositions (slicing, harmonic) share:
+// template fibres mapped through a stack of contours, fibre ends carried to
+// their attachment areas, and fibres smoothed and resampled.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/fibres/decomposition.h"
+#include "core/fibres/fibre_set.h"
+#include "core/fibres/fibre_templates.h"
+#include "core/mesh/winding_number.h"
+
+namespace mmm::fibres {
+
+// Fibre f's point k is the mean-value image (contour_map.h) of template
+// fibre f at s = k / (#contours - 1) in contour k. Contours: >= 2, one point
+// count (a multiple of 8) for all.
+std::vector<Fibre> fibres_through_contours(const std::vector<Contour>& contours,
+                                           const std::vector<TemplateFibre>& templates);
+
+// Where each fibre end goes on an attachment area: `points` (the area's
+// samples) and `ends` (each fibre's (u, v) at that end) are both laid out in
+// the cross-section plane of `axes` (u along `reference`, v along axis x
+// reference), each stretched over [0, 1]^2 by its bounding box; each end
+// gets the index of the nearest point. So fibres keep their order and their
+// ends spread over the whole area.
+std::vector<int> match_ends(const Eigen::MatrixX3d& points, const MuscleAxes& axes,
+                            const std::vector<Eigen::Vector2d>& ends);
+
+// The fibre with an extension at each end: a quadratic Bezier from the
+// target to the fibre's end point, arriving along the fibre's own end
+// direction, sampled at about the fibre's mean point spacing.
+Fibre extend_fibre(const Fibre& fibre, const Eigen::Vector3d& origin_target,
+                   const Eigen::Vector3d& insertion_target);
+
+// Mapped fibres finished: each end extended to the muscle surface point
+// nearest its own attachment point (match_ends on the templates' end
+// positions), smoothed (options.smoothing_passes), resampled to
+// options.segments and kept inside the muscle (keep_inside.h, margin
+// kInsideMarginMm). `moved_inside` (when given) counts the points that had to
+// be moved in.
+constexpr double kInsideMarginMm = 0.5;
+std::vector<Fibre> finish_fibres(const std::vector<Fibre>& mapped,
+                                 const std::vector<TemplateFibre>& templates,
+                                 const Attachments& attachments, const MuscleAxes& axes,
+                                 const mesh::WindingNumber& inside,
+                                 const DecompositionOptions& options, int* moved_inside = nullptr);
+
+// `passes` of Laplacian smoothing (each interior point moved half-way to
+// the mean of its neighbours), ends fixed.
+void smooth_fibre(Fibre& fibre, int passes);
+
+// The polyline at segments + 1 points at equal arc-length steps, ends kept.
+Fibre resample_fibre(const Fibre& fibre, int segments);
+
+// Length of a polyline (mm).
+double fibre_length(const Fibre& fibre);
+
+}  // namespace mmm::fibres
