@@ -25,22 +25,23 @@ Eigen::VectorXd squared_distances(const Eigen::MatrixX3d& vertices,
   return nearest;
 }
 
-std::vector<int> within(const Eigen::VectorXd& squared, double distance) {
+// The vertices within `distance` (squared distances `squared`) that are not
+// `taken`; when fewer than kMinimumVertices, the kMinimumVertices nearest
+// ones that are not taken.
+std::vector<int> within(const Eigen::VectorXd& squared, double distance,
+                        const std::vector<bool>& taken) {
   std::vector<int> chosen;
+  std::vector<int> free;
   for (Index v = 0; v < squared.size(); ++v) {
-    if (squared(v) <= distance * distance) {
-      chosen.push_back(static_cast<int>(v));
-    }
+    if (taken[static_cast<std::size_t>(v)]) continue;
+    free.push_back(static_cast<int>(v));
+    if (squared(v) <= distance * distance) chosen.push_back(static_cast<int>(v));
   }
   if (static_cast<int>(chosen.size()) < kMinimumVertices) {
-    std::vector<int> order(static_cast<std::size_t>(squared.size()));
-    for (std::size_t i = 0; i < order.size(); ++i) {
-      order[i] = static_cast<int>(i);
-    }
-    const auto count = std::min<std::size_t>(kMinimumVertices, order.size());
-    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count),
-                      order.end(), [&](int a, int b) { return squared(a) < squared(b); });
-    chosen.assign(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count));
+    const auto count = std::min<std::size_t>(kMinimumVertices, free.size());
+    std::partial_sort(free.begin(), free.begin() + static_cast<std::ptrdiff_t>(count), free.end(),
+                      [&](int a, int b) { return squared(a) < squared(b); });
+    chosen.assign(free.begin(), free.begin() + static_cast<std::ptrdiff_t>(count));
     std::sort(chosen.begin(), chosen.end());
   }
   return chosen;
@@ -55,18 +56,25 @@ AttachmentVertices attachment_vertices(const mesh::IndexedMesh& surface,
   }
   const Eigen::VectorXd to_origin = squared_distances(surface.V, attachments.origin);
   const Eigen::VectorXd to_insertion = squared_distances(surface.V, attachments.insertion);
-  AttachmentVertices result;
-  const std::vector<int> origin = within(to_origin, distance_mm);
-  const std::vector<int> insertion = within(to_insertion, distance_mm);
-  for (const int v : origin) {
-    if (to_origin(v) <= to_insertion(v)) {
-      result.origin.push_back(v);
-    }
+  // A vertex nearer the other area is that area's.
+  const auto n = static_cast<std::size_t>(surface.V.rows());
+  std::vector<bool> nearer_insertion(n);
+  std::vector<bool> nearer_origin(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    nearer_insertion[v] = to_insertion(static_cast<Index>(v)) < to_origin(static_cast<Index>(v));
+    nearer_origin[v] = !nearer_insertion[v];
   }
-  for (const int v : insertion) {
-    if (to_insertion(v) < to_origin(v)) {
-      result.insertion.push_back(v);
-    }
+  AttachmentVertices result;
+  result.origin = within(to_origin, distance_mm, nearer_insertion);
+  std::vector<bool> taken(n, false);
+  for (const int v : result.origin) taken[static_cast<std::size_t>(v)] = true;
+  for (std::size_t v = 0; v < n; ++v) taken[v] = taken[v] || nearer_origin[v];
+  result.insertion = within(to_insertion, distance_mm, taken);
+  if (static_cast<int>(result.insertion.size()) < kMinimumVertices) {
+    // Nothing is nearer the insertion: its nearest vertices not on the origin.
+    std::vector<bool> origin_only(n, false);
+    for (const int v : result.origin) origin_only[static_cast<std::size_t>(v)] = true;
+    result.insertion = within(to_insertion, distance_mm, origin_only);
   }
   return result;
 }

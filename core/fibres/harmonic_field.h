@@ -17,8 +17,9 @@
 namespace mmm::fibres {
 
 // The surface vertices on each attachment area: those within `distance_mm`
-// of one of its points; when fewer than 3, the 3 nearest to the area's
-// points. A vertex claimed by both goes to the nearer area. Throws
+// of one of its points and nearer to it than to the other area; when fewer
+// than 3 (a muscle surface that stops short of its bone), the 3 nearest to
+// the area's points that the other area does not hold. Throws
 // InvalidInputError when an attachment has no points.
 struct AttachmentVertices {
   std::vector<int> origin;

@@ -13,15 +13,12 @@ constexpr double kMaxCut = 0.35;  // and at most this
 
 }  // namespace
 
-SlicingResult slicing_fibres(const mesh::IndexedMesh& surface, const Attachments& attachments,
-                             const DecompositionOptions& options) {
-  validate(options);
-  SlicingResult result;
-  result.axes = muscle_axes(surface, attachments);
-  const MuscleAxes& axes = result.axes;
-  const Eigen::VectorXd height = (surface.V.rowwise() - axes.origin_centre.transpose()) * axes.axis;
-  const double lo = height.minCoeff();
-  const double hi = height.maxCoeff();
+SlicingPlanes slicing_planes(const mesh::IndexedMesh& surface, const Attachments& attachments,
+                             const MuscleAxes& axes, int segments) {
+  SlicingPlanes planes;
+  planes.vertex_heights = (surface.V.rowwise() - axes.origin_centre.transpose()) * axes.axis;
+  const double lo = planes.vertex_heights.minCoeff();
+  const double hi = planes.vertex_heights.maxCoeff();
   const double length = hi - lo;
   const double origin_cut = std::clamp(
       ((attachments.origin.rowwise() - axes.origin_centre.transpose()) * axes.axis).maxCoeff(),
@@ -29,12 +26,20 @@ SlicingResult slicing_fibres(const mesh::IndexedMesh& surface, const Attachments
   const double insertion_cut = std::clamp(
       ((attachments.insertion.rowwise() - axes.origin_centre.transpose()) * axes.axis).minCoeff(),
       hi - kMaxCut * length, hi - kMinCut * length);
-  std::vector<double> levels;
-  for (int k = 0; k <= options.segments; ++k) {
-    levels.push_back(origin_cut + (insertion_cut - origin_cut) * k / options.segments);
+  for (int k = 0; k <= segments; ++k) {
+    planes.levels.push_back(origin_cut + (insertion_cut - origin_cut) * k / segments);
   }
-  ContourStack stack =
-      contour_stack(surface, height, levels, axes.reference, options.contour_points);
+  return planes;
+}
+
+SlicingResult slicing_fibres(const mesh::IndexedMesh& surface, const Attachments& attachments,
+                             const DecompositionOptions& options) {
+  validate(options);
+  SlicingResult result;
+  result.axes = muscle_axes(surface, attachments);
+  const SlicingPlanes planes = slicing_planes(surface, attachments, result.axes, options.segments);
+  ContourStack stack = contour_stack(surface, planes.vertex_heights, planes.levels,
+                                     result.axes.reference, options.contour_points);
   result.interpolated_contours = stack.interpolated;
   result.contours = std::move(stack.contours);
   const std::vector<TemplateFibre> templates =
@@ -42,7 +47,7 @@ SlicingResult slicing_fibres(const mesh::IndexedMesh& surface, const Attachments
   const mesh::AabbTree tree(surface);
   const mesh::WindingNumber inside(tree);
   result.fibres = finish_fibres(fibres_through_contours(result.contours, templates), templates,
-                                attachments, axes, inside, options, &result.moved_inside);
+                                attachments, result.axes, inside, options, &result.moved_inside);
   return result;
 }
 

@@ -27,11 +27,19 @@ namespace mmm::fibres {
 struct SlicingResult {
   std::vector<Fibre> fibres;
   std::vector<Contour> contours;  // the sections the fibres went through
-  int interpolated_contours = 0;
-  int moved_inside =
-      0;  // fibre points moved into the muscle (keep_inside.h)  // planes with no closed section
+  int interpolated_contours = 0;  // planes with no closed section
+  int moved_inside = 0;           // fibre points moved into the muscle (keep_inside.h)
   MuscleAxes axes;
 };
+
+// The heights (along axes.axis, from axes.origin_centre) of the
+// segments + 1 planes of step 2, and the height of every surface vertex.
+struct SlicingPlanes {
+  Eigen::VectorXd vertex_heights;
+  std::vector<double> levels;
+};
+SlicingPlanes slicing_planes(const mesh::IndexedMesh& surface, const Attachments& attachments,
+                             const MuscleAxes& axes, int segments);
 
 // Throws InvalidInputError for bad options or attachments (decomposition.h)
 // or when fewer than two planes have a closed section.
