@@ -2,6 +2,7 @@
 
 #include "nodes/build_hulls.h"
 #include "nodes/decimate_mesh.h"
+#include "nodes/decompose_fibres.h"
 #include "nodes/fuse_motion.h"
 #include "nodes/import_markups.h"
 #include "nodes/landmark_report.h"
@@ -29,6 +30,7 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<FuseMotion>();
   registry.add<BuildHulls>();
   registry.add<WrapMuscles>();
+  registry.add<DecomposeFibres>();
   return registry;
 }
 

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -15,6 +17,7 @@
 #include "core/errors.h"
 #include "core/mesh/io/pvd.h"
 #include "nodes/build_hulls.h"
+#include "nodes/decompose_fibres.h"
 #include "nodes/fuse_motion.h"
 #include "tests/nodes/node_harness.h"
 #include "tests/support/test_data.h"
@@ -57,9 +60,34 @@ void add_neighbour(mmm::test::ToyLeg& leg, double overlap) {
   leg.atlas.muscles.push_back(neighbour);
 }
 
+// An insertion area for the toy vastus: the 8 tibia faces nearest its
+// action line's insertion point (the toy leg has only an origin).
+void add_insertion(mmm::test::ToyLeg& leg) {
+  atlas::Muscle& muscle = leg.atlas.muscles.front();
+  const Eigen::Vector3d end = muscle.action_lines.front().points.back().position;
+  const mesh::IndexedMesh& tibia = leg.meshes.at("tibia_r").at("full");
+  atlas::AttachmentArea area;
+  area.bone = "tibia_r";
+  std::vector<std::pair<double, int>> by_distance;
+  for (Eigen::Index f = 0; f < tibia.F.rows(); ++f) {
+    const Eigen::Vector3d centroid =
+        (tibia.V.row(tibia.F(f, 0)) + tibia.V.row(tibia.F(f, 1)) + tibia.V.row(tibia.F(f, 2)))
+            .transpose() /
+        3.0;
+    by_distance.emplace_back((centroid - end).norm(), static_cast<int>(f));
+  }
+  std::sort(by_distance.begin(), by_distance.end());
+  for (std::size_t i = 0; i < std::min<std::size_t>(8, by_distance.size()); ++i) {
+    area.faces.push_back(by_distance[i].second);
+  }
+  area.centroid = end;
+  muscle.insertions = {area};
+}
+
 ToyLegAndWalk toy_leg_and_walk(test::NodeHarness& harness, double end_time,
-                               double neighbour_overlap = -1.0) {
+                               double neighbour_overlap = -1.0, bool with_insertion = false) {
   ToyLegAndWalk result{mmm::test::toy_leg(), {}, {}};
+  if (with_insertion) add_insertion(result.leg);
   if (neighbour_overlap >= 0.0) add_neighbour(result.leg, neighbour_overlap);
   for (const auto& [name, x] : {std::pair{"R.ASIS", 150.0}, {"L.ASIS", -60.0}}) {
     result.leg.atlas.markers.push_back({name, "pelvis", Eigen::Vector3d(x, 30, 20), true});
@@ -112,6 +140,60 @@ TEST(WrapMusclesNodeTest, WrapsTheToyLegsMuscleOverARetargetedWalk) {
   EXPECT_EQ(muscle_frames, (frames + 1) / 2);
   EXPECT_TRUE(std::filesystem::exists(animation / "wrapping" / "action_lines_0000.vtp"));
   EXPECT_TRUE(std::filesystem::exists(animation / "wrapping" / "femur_r_0000.vtp"));
+}
+
+// decompose_fibres after wrap_muscles: fibres at every frame of the
+// animation, inside the muscle, following it (their lengths change with the
+// knee), with a picture and a report; bad parameters are refused by name.
+TEST(DecomposeFibresNodeTest, FibresFollowTheWrappedMuscleFrameByFrame) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.9, -1.0, true);
+  const auto wrapped = harness.run<WrapMuscles>({{"atlas", toy.atlas}, {"motion", toy.motion}},
+                                                {{"animation_stride", std::int64_t{6}}});
+  const auto outputs =
+      harness.run<DecomposeFibres>({{"atlas", toy.atlas}, {"animation", wrapped.at("animation")}},
+                                   {{"fibres", std::int64_t{16}}, {"segments", std::int64_t{10}}});
+  const nlohmann::json report =
+      nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+  const int frames = report["frames"];
+  EXPECT_GE(frames, 4);
+  EXPECT_GE(report["min_inside_fraction"].get<double>(), 0.99);
+  ASSERT_EQ(report["muscles"].size(), 1U);
+  EXPECT_EQ(report["muscles"][0]["method"], "harmonic");
+  EXPECT_EQ(report["muscles"][0]["fibres"], 16);
+  // One length per fibre and frame; the lengths change over the walk.
+  std::istringstream csv(mmm::test::read_text(outputs.at("lengths").path));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "muscle,method,fibre,frame,time_s,length_mm");
+  std::map<int, double> total;
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    std::vector<std::string> cells;
+    std::stringstream cell_stream(line);
+    for (std::string cell; std::getline(cell_stream, cell, ',');) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 6U);
+    total[std::stoi(cells[3])] += std::stod(cells[5]);
+  }
+  EXPECT_EQ(rows, 16 * frames);
+  double shortest = 1e300;
+  double longest = 0.0;
+  for (const auto& [frame, length] : total) {
+    shortest = std::min(shortest, length);
+    longest = std::max(longest, length);
+  }
+  EXPECT_GT(longest - shortest, 0.01 * longest);
+  const std::filesystem::path fibres = harness.folder() / "fibres";
+  unpack_directory(mmm::test::read_text(outputs.at("fibres").path), fibres, "fibres");
+  EXPECT_EQ(mesh::read_pvd(fibres / "fibres.pvd").size(), static_cast<std::size_t>(frames));
+  EXPECT_EQ(mmm::test::read_text(outputs.at("picture").path).substr(1, 3), "PNG");
+  EXPECT_THROW((void)harness.run<DecomposeFibres>({{"atlas", toy.atlas}},
+                                                  {{"methods", std::string("vastus_r=voxels")}}),
+               InvalidInputError);
+  EXPECT_THROW((void)harness.run<DecomposeFibres>({{"atlas", toy.atlas}},
+                                                  {{"muscles", std::string("nobody")}}),
+               InvalidInputError);
 }
 
 TEST(WrapMusclesNodeTest, StoredHullsAreReusedWhileTheSurfaceAndFaceCountMatch) {

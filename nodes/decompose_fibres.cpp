@@ -1,0 +1,306 @@
+#include "nodes/decompose_fibres.h"
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/atlas/atlas_io.h"
+#include "core/directory_bundle.h"
+#include "core/errors.h"
+#include "core/fibres/fibre_mapping.h"
+#include "core/fibres/fibre_quality.h"
+#include "core/fibres/muscle_fibres.h"
+#include "core/fit/rigid_fit.h"
+#include "core/image/png.h"
+#include "core/mesh/io/mesh_io.h"
+#include "core/mesh/io/pvd.h"
+#include "core/mesh/io/vtp.h"
+#include "core/mesh/io/vtp_series.h"
+#include "core/wrapping/muscle_hulls.h"
+#include "core/wrapping/muscle_wrapping.h"
+#include "nodes/fibre_picture.h"
+#include "nodes/name_list.h"
+
+namespace mmm::nodes {
+namespace {
+
+using fibres::DecompositionMethod;
+
+std::string fixed(double value, int decimals) {
+  std::vector<char> buffer(64);
+  std::snprintf(buffer.data(), buffer.size(), "%.*f", decimals, value);
+  return buffer.data();
+}
+
+// "muscle=method,..." -> map; names checked against the atlas.
+std::map<std::string, DecompositionMethod> method_overrides(const std::string& text,
+                                                            const atlas::Atlas& atlas) {
+  std::map<std::string, DecompositionMethod> overrides;
+  for (const std::string& item : split_names(text)) {
+    const auto equals = item.find('=');
+    const std::string muscle = item.substr(0, equals);
+    const auto method = equals == std::string::npos
+                            ? std::nullopt
+                            : fibres::method_from_name(item.substr(equals + 1));
+    if (!method || atlas.find_muscle(muscle) == nullptr) {
+      throw InvalidInputError("decompose_fibres: parameter 'methods': '" + item +
+                              "' is not MUSCLE=METHOD with an atlas muscle and one of slicing, "
+                              "harmonic, mass_spring, cadaver");
+    }
+    overrides[muscle] = *method;
+  }
+  return overrides;
+}
+
+// One frame of a wrap_muscles animation: time, and the file of each part.
+struct AnimationFrame {
+  double time = 0.0;
+  std::map<std::string, std::filesystem::path> parts;
+};
+
+std::vector<AnimationFrame> animation_frames(const std::filesystem::path& folder) {
+  const std::filesystem::path pvd = folder / "wrapping.pvd";
+  if (!std::filesystem::exists(pvd)) {
+    throw InvalidInputError(
+        "decompose_fibres: input 'animation' has no wrapping.pvd; hint: connect wrap_muscles's "
+        "'animation' output");
+  }
+  std::vector<AnimationFrame> frames;
+  for (const mesh::PvdEntry& entry : mesh::read_pvd(pvd)) {
+    if (frames.empty() || frames.back().time != entry.time) frames.push_back({entry.time, {}});
+    frames.back().parts[entry.name] = folder / entry.file;
+  }
+  return frames;
+}
+
+// A bone's rest -> frame transform from its drawn surface: the atlas level
+// with as many vertices, rigidly fitted onto the frame's copy.
+class BonePoses {
+ public:
+  BonePoses(const atlas::Atlas& atlas, const std::filesystem::path& atlas_dir)
+      : atlas_(atlas), atlas_dir_(atlas_dir) {}
+
+  Eigen::Isometry3d pose(const std::string& bone, const AnimationFrame& frame) {
+    const auto part = frame.parts.find(bone);
+    if (part == frame.parts.end()) {
+      throw InvalidInputError("decompose_fibres: the animation has no bone '" + bone +
+                              "' at time " + fixed(frame.time, 4) + "; hint: wrap the same atlas");
+    }
+    const mesh::IndexedMesh posed = mesh::read_vtp(part->second);
+    return fit::rigid_fit(rest_level(bone, posed.V.rows()), posed.V).rigid;
+  }
+
+ private:
+  const Eigen::MatrixX3d& rest_level(const std::string& bone, Eigen::Index vertices) {
+    const std::string key = bone + "#" + std::to_string(vertices);
+    if (const auto found = cache_.find(key); found != cache_.end()) return found->second;
+    const atlas::Bone* b = atlas_.find_bone(bone);
+    for (const atlas::MeshLevel& level : b->meshes) {
+      mesh::IndexedMesh m = mesh::read_mesh(atlas_dir_ / level.file);
+      if (m.V.rows() == vertices) return cache_.emplace(key, std::move(m.V)).first->second;
+    }
+    throw InvalidInputError("decompose_fibres: bone '" + bone + "' of the animation has " +
+                            std::to_string(vertices) +
+                            " vertices, no level of the atlas's bone has; hint: wrap this atlas");
+  }
+
+  const atlas::Atlas& atlas_;
+  std::filesystem::path atlas_dir_;
+  std::map<std::string, Eigen::MatrixX3d> cache_;
+};
+
+mesh::Polylines as_polylines(const std::vector<fibres::Fibre>& fibres) {
+  mesh::Polylines lines;
+  Eigen::Index points = 0;
+  for (const fibres::Fibre& f : fibres) points += f.rows();
+  lines.points.resize(points, 3);
+  Eigen::Index row = 0;
+  for (const fibres::Fibre& f : fibres) {
+    std::vector<int> line;
+    for (Eigen::Index k = 0; k < f.rows(); ++k) {
+      line.push_back(static_cast<int>(row));
+      lines.points.row(row++) = f.row(k);
+    }
+    lines.lines.push_back(std::move(line));
+  }
+  return lines;
+}
+
+}  // namespace
+
+workflow::NodeSpec DecomposeFibres::spec() {
+  using workflow::port::Atlas;
+  using workflow::port::File;
+  using workflow::port::Report;
+  const fibres::DecompositionOptions d;
+  const wrapping::MuscleWrappingOptions w;
+  return workflow::NodeSpec{
+      "decompose_fibres", 1,
+      "Every muscle's volume filled with fibres (slicing, harmonic, mass-spring or cadaver "
+      "method), at rest and in every frame of a wrapped motion"}
+      .input<Atlas>("atlas", "The (scaled) atlas")
+      .optional_input<File>("animation",
+                            "wrap_muscles's animation of this atlas: its frames are decomposed "
+                            "(the fibres follow the wrapped muscles)")
+      .param_enum("method", "harmonic", {"slicing", "harmonic", "mass_spring", "cadaver"},
+                  "Decomposition method of every muscle (cadaver: this atlas has no measured "
+                  "fibres, so four stand-ins traced on the muscle are used)")
+      .param<std::string>("methods", "",
+                          "Per-muscle methods overriding 'method': MUSCLE=METHOD,...")
+      .param<std::int64_t>("fibres", d.fibres,
+                           "Fibres per muscle (mass-spring and cadaver: the "
+                           "nearest square)",
+                           {.min = 9, .max = 10000})
+      .param<std::int64_t>("segments", d.segments, "Segments per fibre", {.min = 2, .max = 1000})
+      .param<std::int64_t>("target_faces", w.target_faces,
+                           "Muscle surface resolution, as wrap_muscles's target_faces (0: full)",
+                           {.min = 0, .max = 1000000})
+      .param<std::string>("muscles", "",
+                          "Comma-separated muscle names; empty: every muscle of the atlas")
+      .param<std::string>("picture_muscle", "gluteus_medius_r",
+                          "The muscle shown in the picture (the first one when absent)")
+      .output<File>("fibres", "Folder bundle: fibres.pvd + .vtp polylines per muscle and frame")
+      .output<File>("lengths", "CSV: muscle, method, fibre, frame, time (s), length (mm)")
+      .output<File>("picture", "PNG: a muscle with its fibres, front and side")
+      .output<Report>("report", "Per muscle: method, quality at rest, times");
+}
+
+void DecomposeFibres::run(workflow::NodeContext& context) {
+  const auto started = std::chrono::steady_clock::now();
+  const std::filesystem::path atlas_dir = context.scratch_dir() / "atlas";
+  unpack_directory(context.input_bytes("atlas"), atlas_dir, "input 'atlas'");
+  const atlas::Atlas atlas = atlas::read_atlas(atlas_dir);
+  std::vector<const atlas::Muscle*> muscles;
+  for (const std::string& name : split_names(context.text("muscles"))) {
+    const atlas::Muscle* muscle = atlas.find_muscle(name);
+    if (muscle == nullptr) {
+      throw InvalidInputError("decompose_fibres: parameter 'muscles': the atlas has no muscle '" +
+                              name + "'");
+    }
+    muscles.push_back(muscle);
+  }
+  if (muscles.empty()) {
+    for (const atlas::Muscle& muscle : atlas.muscles) muscles.push_back(&muscle);
+  }
+  const DecompositionMethod default_method = *fibres::method_from_name(context.text("method"));
+  const auto overrides = method_overrides(context.text("methods"), atlas);
+  fibres::DecompositionOptions options;
+  options.fibres = static_cast<int>(context.integer("fibres"));
+  options.segments = static_cast<int>(context.integer("segments"));
+  std::map<std::string, mesh::IndexedMesh> bones;
+  const auto bone_surface = [&](const std::string& name) -> const mesh::IndexedMesh& {
+    auto found = bones.find(name);
+    if (found == bones.end()) {
+      const atlas::Bone* bone = atlas.find_bone(name);
+      found = bones.emplace(name, atlas::load_mesh(atlas_dir, bone->meshes)).first;
+    }
+    return found->second;
+  };
+  std::vector<AnimationFrame> frames;
+  std::filesystem::path animation_dir;
+  if (context.has_input("animation")) {
+    animation_dir = context.scratch_dir() / "animation";
+    unpack_directory(context.input_bytes("animation"), animation_dir, "input 'animation'");
+    frames = animation_frames(animation_dir);
+  }
+  BonePoses poses(atlas, atlas_dir);
+
+  const std::filesystem::path folder = context.scratch_dir() / "fibres";
+  std::filesystem::remove_all(folder);
+  mesh::VtpSeriesWriter series(folder, "fibres");
+  std::string csv = "muscle,method,fibre,frame,time_s,length_mm\n";
+  nlohmann::json rows = nlohmann::json::array();
+  double worst_inside = 1.0;
+  const std::string picture_name = context.text("picture_muscle");
+  const atlas::Muscle* pictured = atlas.find_muscle(picture_name);
+  if (pictured == nullptr) pictured = muscles.front();
+  std::vector<fibres::Fibre> pictured_fibres;
+  mesh::IndexedMesh pictured_surface;
+  for (std::size_t m = 0; m < muscles.size(); ++m) {
+    const atlas::Muscle& muscle = *muscles[m];
+    context.progress(static_cast<std::int64_t>(m), static_cast<std::int64_t>(muscles.size()),
+                     "fibres of " + muscle.name);
+    const auto found = overrides.find(muscle.name);
+    const DecompositionMethod method = found != overrides.end() ? found->second : default_method;
+    fibres::DecompositionOptions muscle_options = options;
+    muscle_options.architecture = muscle.architecture;
+    const fibres::MuscleFibreModel model(
+        muscle.name, wrapping::wrapping_surface(muscle, atlas_dir, context.integer("target_faces")),
+        fibres::attachment_samples(muscle, bone_surface), method, muscle_options);
+    const fibres::MuscleFibres rest = model.decompose_at_rest();
+    const fibres::FibreQuality quality = fibres::measure_fibre_quality(
+        model.rest(), rest.fibres, rest.attachments.origin, rest.attachments.insertion);
+    worst_inside = std::min(worst_inside, quality.inside_fraction);
+    if (&muscle == pictured) {
+      pictured_fibres = rest.fibres;
+      pictured_surface = model.rest();
+    }
+    const auto add_frame = [&](const fibres::MuscleFibres& result, int frame, double time) {
+      series.add_polylines(time, frame, muscle.name, as_polylines(result.fibres));
+      for (std::size_t f = 0; f < result.fibres.size(); ++f) {
+        csv += muscle.name + "," + std::string(fibres::method_name(method)) + "," +
+               std::to_string(f) + "," + std::to_string(frame) + "," + fixed(time, 4) + "," +
+               fixed(fibres::fibre_length(result.fibres[f]), 3) + "\n";
+      }
+    };
+    double frame_seconds = 0.0;
+    if (frames.empty()) {
+      add_frame(rest, 0, 0.0);
+    } else {
+      for (std::size_t k = 0; k < frames.size(); ++k) {
+        const AnimationFrame& frame = frames[k];
+        const auto part = frame.parts.find(muscle.name);
+        if (part == frame.parts.end()) {
+          throw InvalidInputError("decompose_fibres: the animation has no muscle '" + muscle.name +
+                                  "' at time " + fixed(frame.time, 4) +
+                                  "; hint: wrap the same muscles");
+        }
+        const mesh::IndexedMesh wrapped = mesh::read_vtp(part->second);
+        const fibres::MuscleFibres result = model.decompose(
+            wrapped.V, [&](const std::string& bone) { return poses.pose(bone, frame); });
+        frame_seconds += result.seconds;
+        add_frame(result, static_cast<int>(k), frame.time);
+      }
+    }
+    nlohmann::json row = quality;
+    row["muscle"] = muscle.name;
+    row["method"] = std::string(fibres::method_name(method));
+    row["stand_in_measured"] = rest.stand_in_measured;
+    row["moved_inside"] = rest.moved_inside;
+    row["rest_ms"] = 1000.0 * rest.seconds;
+    row["field_ms"] = 1000.0 * model.field_seconds();
+    row["frames"] = frames.size();
+    row["frames_ms"] = 1000.0 * frame_seconds;
+    rows.push_back(row);
+  }
+  if (worst_inside < 0.99) {
+    context.warn("a muscle keeps only " + fixed(100.0 * worst_inside, 2) +
+                 " % of its fibre points inside (see the report)");
+  }
+  series.finish();
+  context.set_output("fibres", pack_directory(folder));
+  context.set_output("lengths", csv);
+  const std::filesystem::path picture = context.scratch_dir() / "fibres.png";
+  image::write_png(fibre_picture(pictured_surface, pictured_fibres), picture);
+  context.set_output_file("picture", picture);
+  context.set_output(
+      "report",
+      nlohmann::json{
+          {"muscles", rows},
+          {"frames", frames.size()},
+          {"fibres", options.fibres},
+          {"segments", options.segments},
+          {"min_inside_fraction", worst_inside},
+          {"picture_muscle", pictured->name},
+          {"node_seconds",
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()}}
+          .dump(2));
+  context.progress(static_cast<std::int64_t>(muscles.size()),
+                   static_cast<std::int64_t>(muscles.size()), "done");
+}
+
+}  // namespace mmm::nodes
