@@ -146,7 +146,7 @@ workflow::NodeSpec DecomposeFibres::spec() {
       .optional_input<File>("animation",
                             "wrap_muscles's animation of this atlas: its frames are decomposed "
                             "(the fibres follow the wrapped muscles)")
-      .param_enum("method", "harmonic", {"slicing", "harmonic", "mass_spring", "cadaver"},
+      .param_enum("method", "slicing", {"slicing", "harmonic", "mass_spring", "cadaver"},
                   "Decomposition method of every muscle (cadaver: this atlas has no measured "
                   "fibres, so four stand-ins traced on the muscle are used)")
       .param<std::string>("methods", "",

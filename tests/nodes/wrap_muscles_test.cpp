@@ -159,7 +159,7 @@ TEST(DecomposeFibresNodeTest, FibresFollowTheWrappedMuscleFrameByFrame) {
   EXPECT_GE(frames, 4);
   EXPECT_GE(report["min_inside_fraction"].get<double>(), 0.99);
   ASSERT_EQ(report["muscles"].size(), 1U);
-  EXPECT_EQ(report["muscles"][0]["method"], "harmonic");
+  EXPECT_EQ(report["muscles"][0]["method"], "slicing");
   EXPECT_EQ(report["muscles"][0]["fibres"], 16);
   // One length per fibre and frame; the lengths change over the walk.
   std::istringstream csv(mmm::test::read_text(outputs.at("lengths").path));
