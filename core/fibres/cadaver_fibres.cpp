@@ -1,6 +1,7 @@
 #include "core/fibres/cadaver_fibres.h"
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <optional>
@@ -110,10 +111,12 @@ std::vector<Vector3d> vertex_normals(const mesh::IndexedMesh& mesh) {
     const Vector3d n = (b - a).cross(c - a);
     if (!(n.norm() > 0.0)) continue;  // degenerate: no direction to give
     const Vector3d unit = n.normalized();
-    const Vector3d corners[3] = {a, b, c};
+    const std::array<Vector3d, 3> corners = {a, b, c};
     for (int k = 0; k < 3; ++k) {
-      const Vector3d e1 = corners[(k + 1) % 3] - corners[k];
-      const Vector3d e2 = corners[(k + 2) % 3] - corners[k];
+      const Vector3d e1 = corners.at(static_cast<std::size_t>((k + 1) % 3)) -
+                          corners.at(static_cast<std::size_t>(k));
+      const Vector3d e2 = corners.at(static_cast<std::size_t>((k + 2) % 3)) -
+                          corners.at(static_cast<std::size_t>(k));
       const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
       normals[static_cast<std::size_t>(mesh.F(f, k))] += angle * unit;
     }

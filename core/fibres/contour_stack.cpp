@@ -51,7 +51,7 @@ ContourStack contour_stack(const mesh::IndexedMesh& surface, const Eigen::Vector
     }
     if (below && above) {
       const double w = (levels[k] - levels[*below]) / (levels[*above] - levels[*below]);
-      stack.contours.push_back((1.0 - w) * *found[*below] + w * *found[*above]);
+      stack.contours.emplace_back((1.0 - w) * *found[*below] + w * *found[*above]);
     } else {
       stack.contours.push_back(*found[below ? *below : *above]);
     }

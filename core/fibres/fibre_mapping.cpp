@@ -94,7 +94,7 @@ std::vector<Vector3d> bridge(const Vector3d& target, const Vector3d& end,
   for (int i = 0; i < steps; ++i) {
     const double t = static_cast<double>(i) / steps;
     const double r = 1.0 - t;
-    out.push_back(r * r * target + 2.0 * r * t * control + t * t * end);
+    out.emplace_back(r * r * target + 2.0 * r * t * control + t * t * end);
   }
   return out;
 }

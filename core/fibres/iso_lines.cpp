@@ -58,8 +58,8 @@ Crossings find_crossings(const mesh::IndexedMesh& surface, const Eigen::VectorXd
       const double fa = values(a) - level;
       const double fb = values(b) - level;
       const double w = fa / (fa - fb);  // fa and fb differ in sign: w in [0, 1]
-      crossings.points.push_back((1.0 - w) * surface.V.row(a).transpose() +
-                                 w * surface.V.row(b).transpose());
+      crossings.points.emplace_back((1.0 - w) * surface.V.row(a).transpose() +
+                                    w * surface.V.row(b).transpose());
       crossings.next.push_back(kNone);
       crossings.previous.push_back(kNone);
       crossings.branching.push_back(false);

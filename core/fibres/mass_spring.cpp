@@ -153,11 +153,15 @@ class SpringSystem {
   void across(Index p, Index q, double s) {
     diagonal(p, s);
     diagonal(q, s);
-    couple(p, q, -s * Eigen::Matrix2d::Identity());
+    for (Index r = 0; r < 2; ++r) {  // the block is -s I: no zeros stored
+      triplets_.emplace_back(2 * p + r, 2 * q + r, -s);
+      triplets_.emplace_back(2 * q + r, 2 * p + r, -s);
+    }
   }
 
   // An along spring of stiffness s between particle p of layer lp and q of
-  // layer lq: energy s/2 |w_p - w_q|^2 in the header's terms.
+  // layer lq, of energy (the header's) s/2 r_p r_q |(p - c_p) / r_p - (q -
+  // c_q) / r_q|^2 with c a layer's origin and r its size.
   void along(Index p, const Layer& lp, Index q, const Layer& lq, double s) {
     diagonal(p, s * lq.size / lp.size);
     diagonal(q, s * lp.size / lq.size);
@@ -189,6 +193,53 @@ class SpringSystem {
 
   std::vector<Eigen::Triplet<double>> triplets_;
   Eigen::VectorXd rhs_;
+};
+
+// Solves A d = b (A of SpringSystem) by conjugate gradients, preconditioned
+// with A's along chains: A without the couplings between particles of one
+// layer, one block-tridiagonal system per fibre whose LDLT has no fill. The
+// chains carry the along springs exactly, so the count of steps depends on
+// the layer grid (about its width), not on the stiffness ratio.
+class ChainPreconditionedCg {
+ public:
+  ChainPreconditionedCg(const Eigen::SparseMatrix<double>& a, Index layer_unknowns) : a_(a) {
+    Eigen::SparseMatrix<double> chains = a;
+    chains.prune([&](const Index& r, const Index& c, const double&) {
+      return r / 2 == c / 2 || r / layer_unknowns != c / layer_unknowns;
+    });
+    chains_.compute(chains);
+    if (chains_.info() != Eigen::Success) {
+      throw SolverError("mass_spring: the LDLT factorisation of the fibres' along chains (" +
+                        std::to_string(a.rows()) + " unknowns) failed");
+    }
+  }
+
+  // To a residual of kRelativeResidual |b|, or after as many steps as
+  // unknowns (rounding) and a margin.
+  [[nodiscard]] Eigen::VectorXd solve(const Eigen::VectorXd& b) const {
+    constexpr double kRelativeResidual = 1e-12;
+    Eigen::VectorXd d = Eigen::VectorXd::Zero(b.size());
+    Eigen::VectorXd r = b;
+    Eigen::VectorXd z = chains_.solve(r);
+    Eigen::VectorXd p = z;
+    double rz = r.dot(z);
+    const double stop = kRelativeResidual * b.norm();
+    for (Index step = 0; step < b.size() + 100 && r.norm() > stop; ++step) {
+      const Eigen::VectorXd ap = a_ * p;
+      const double alpha = rz / p.dot(ap);
+      d += alpha * p;
+      r -= alpha * ap;
+      z = chains_.solve(r);
+      const double rz_next = r.dot(z);
+      p = z + (rz_next / rz) * p;
+      rz = rz_next;
+    }
+    return d;
+  }
+
+ private:
+  const Eigen::SparseMatrix<double>& a_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> chains_;
 };
 
 void check_options(const MassSpringOptions& options) {
@@ -229,7 +280,7 @@ MassSpringResult mass_spring_fibres(const std::vector<Contour>& layers,
   check_orientation(planes);
 
   const int grid = options.grid;
-  const Index count = static_cast<Index>(layers.size());
+  const auto count = static_cast<Index>(layers.size());
   const Index side = grid - 2;  // interior particles per grid row of a layer
   const auto interior = [&](int i, int j) {
     return i > 0 && j > 0 && i < grid - 1 && j < grid - 1;
@@ -246,9 +297,8 @@ MassSpringResult mass_spring_fibres(const std::vector<Contour>& layers,
                 static_cast<std::size_t>(j)]
         .row(k);
   };
-  const auto unit = [&](int i) {
-    return static_cast<double>(i) / (grid - 1);
-  };  // 1 exactly at the end
+  // i / (grid - 1), exactly 1 at i = grid - 1 (a border particle on the contour).
+  const auto unit = [&](int i) { return static_cast<double>(i) / (grid - 1); };
   Eigen::VectorXd x(2 * count * side * side);
   for (Index k = 0; k < count; ++k) {
     for (int i = 0; i < grid; ++i) {
@@ -290,11 +340,7 @@ MassSpringResult mass_spring_fibres(const std::vector<Contour>& layers,
   }
 
   const Eigen::SparseMatrix<double> a = system.matrix();
-  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
-  if (solver.info() != Eigen::Success) {
-    throw SolverError("mass_spring: the sparse LDLT factorisation of the " +
-                      std::to_string(a.rows()) + " balance equations failed");
-  }
+  const ChainPreconditionedCg solver(a, 2 * side * side);
   while (result.iterations < options.max_iterations) {
     const Eigen::VectorXd move = solver.solve(system.rhs() - a * x);
     x += move;
