@@ -6,6 +6,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/atlas/atlas_io.h"
@@ -81,8 +82,8 @@ std::vector<AnimationFrame> animation_frames(const std::filesystem::path& folder
 // with as many vertices, rigidly fitted onto the frame's copy.
 class BonePoses {
  public:
-  BonePoses(const atlas::Atlas& atlas, const std::filesystem::path& atlas_dir)
-      : atlas_(atlas), atlas_dir_(atlas_dir) {}
+  BonePoses(const atlas::Atlas& atlas, std::filesystem::path atlas_dir)
+      : atlas_(atlas), atlas_dir_(std::move(atlas_dir)) {}
 
   Eigen::Isometry3d pose(const std::string& bone, const AnimationFrame& frame) {
     const auto part = frame.parts.find(bone);

@@ -9,9 +9,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "core/errors.h"
 
@@ -42,7 +44,8 @@ std::vector<Contour> cylinder(int points) {
 }
 
 const Fibre& fibre(const MassSpringResult& r, int grid, int i, int j) {
-  return r.fibres[static_cast<std::size_t>(i * grid + j)];
+  return r.fibres[static_cast<std::size_t>(i) * static_cast<std::size_t>(grid) +
+                  static_cast<std::size_t>(j)];
 }
 
 bool border(int grid, int i, int j) { return i == 0 || j == 0 || i == grid - 1 || j == grid - 1; }
@@ -74,8 +77,9 @@ bool inside_polygon(const Contour& c, const Vector2d& p) {
 }
 
 // Largest net spring force in x y on an interior particle, from the fibres
-// and the header's energy; zero at the balance. For regular polygons in
-// planes of constant z: the centroid is the vertex mean.
+// and the header's energy; zero at the balance. For polygons in planes of
+// constant z, symmetric about their centre (then centroid and vertex mean
+// coincide).
 double largest_imbalance(const std::vector<Contour>& layers, const MassSpringResult& r,
                          const MassSpringOptions& o) {
   std::vector<Vector2d> centre;
@@ -220,16 +224,16 @@ TEST(MassSpringTest, ATiltedSquarePrismGivesTheEvenlySpacedGrid) {
 
 TEST(MassSpringTest, FibresOfATaperingFrustumStayInsideEveryContour) {
   // 13 layers 5 mm apart, radius 20 at z = 0 to 8 at z = 60, the axis leaning
-  // toward +x by 0.1 mm per mm; then the same flattening to 8 by 14 mm
-  // (not similar layers: the along springs pull).
+  // toward +x by 0.1 mm per mm; then the same flattening to an ellipse of 8
+  // by 12 mm (layers not similar: the along springs pull).
   for (const double flatten : {0.0, 0.5}) {
     std::vector<Contour> layers;
     for (int k = 0; k <= 12; ++k) {
       Contour c = circle(20.0 - k, 5.0 * k, 48, 0.5 * k);
-      c.col(1) *= 1.0 + flatten * k / 12.0 * (14.0 / 8.0 - 1.0);
+      c.col(1) *= 1.0 + flatten * k / 12.0;
       layers.push_back(c);
     }
-    for (const double along : {1.0, 10.0}) {
+    for (const double along : {1.0, 10.0, 1e4}) {
       MassSpringOptions options;
       options.along_stiffness = along;
       const MassSpringResult r = mass_spring_fibres(layers, options);
@@ -245,12 +249,14 @@ TEST(MassSpringTest, FibresOfATaperingFrustumStayInsideEveryContour) {
           }
         }
       }
-      // Measured 1.02 mm (similar layers, any along stiffness), 1.10 and 1.08
-      // mm flattening (along 1, 10): the interior corners next to the border's
-      // at the small end, where the border fibres are 1.6 mm apart.
-      EXPECT_GT(closest, 0.9) << flatten << " " << along;
-      // Forces are ~ 10 stiffness mm, so 1e-9 is rounding of the solve.
-      EXPECT_LT(largest_imbalance(layers, r, options), 1e-9) << flatten << " " << along;
+      // Measured 1.02 mm (similar layers, any along stiffness); 1.12, 1.07 and
+      // 0.93 mm flattening (along 1, 10, 1e4): the interior corners next to
+      // the border's at the small end, where border fibres are 1.6 mm apart.
+      EXPECT_GT(closest, 0.8) << flatten << " " << along;
+      // Forces are ~ 10 (1 + along) stiffness mm; 1e-11 of that is rounding
+      // (measured 3e-14 to 2.4e-10).
+      EXPECT_LT(largest_imbalance(layers, r, options), 1e-10 * (1.0 + along))
+          << flatten << " " << along;
       EXPECT_TRUE(r.converged);
     }
   }
@@ -272,7 +278,7 @@ TEST(MassSpringTest, ConvergesAndReportsTheLastMove) {
   const MassSpringResult first = mass_spring_fibres(cylinder(64), once);
   EXPECT_FALSE(first.converged);
   EXPECT_EQ(first.iterations, 1);
-  EXPECT_GT(first.largest_move_mm, 0.1);  // measured 0.89 mm
+  EXPECT_GT(first.largest_move_mm, 0.1);  // measured 1.25 mm
   EXPECT_LT(first.largest_move_mm, 2.0);
 }
 
