@@ -46,6 +46,7 @@ TEST(ConstrainedSplineTest, SlopesFollowKruger) {
 TEST(ConstrainedSplineTest, ReproducesAStraightLine) {
   const std::vector<double> x = {0.0, 0.3, 1.7, 2.0, 5.5, 6.0};  // uneven steps
   std::vector<double> y;
+  y.reserve(x.size());
   for (const double v : x) y.push_back(3.0 * v - 2.0);
   const ConstrainedSpline spline(x, y);
   double worst = 0.0;
