@@ -79,20 +79,26 @@ std::vector<AnimationFrame> animation_frames(const std::filesystem::path& folder
 }
 
 // A bone's rest -> frame transform from its drawn surface: the atlas level
-// with as many vertices, rigidly fitted onto the frame's copy.
+// with as many vertices, rigidly fitted onto the frame's copy. Fitted once
+// per bone and frame, however many muscles attach to the bone.
 class BonePoses {
  public:
   BonePoses(const atlas::Atlas& atlas, std::filesystem::path atlas_dir)
       : atlas_(atlas), atlas_dir_(std::move(atlas_dir)) {}
 
-  Eigen::Isometry3d pose(const std::string& bone, const AnimationFrame& frame) {
+  Eigen::Isometry3d pose(const std::string& bone, std::size_t index, const AnimationFrame& frame) {
+    const auto known = poses_.find({bone, index});
+    if (known != poses_.end()) return known->second;
     const auto part = frame.parts.find(bone);
     if (part == frame.parts.end()) {
       throw InvalidInputError("decompose_fibres: the animation has no bone '" + bone +
                               "' at time " + fixed(frame.time, 4) + "; hint: wrap the same atlas");
     }
     const mesh::IndexedMesh posed = mesh::read_vtp(part->second);
-    return fit::rigid_fit(rest_level(bone, posed.V.rows()), posed.V).rigid;
+    const Eigen::Isometry3d fitted =
+        fit::rigid_fit(rest_level(bone, posed.V.rows()), posed.V).rigid;
+    poses_.emplace(std::pair{bone, index}, fitted);
+    return fitted;
   }
 
  private:
@@ -112,6 +118,7 @@ class BonePoses {
   const atlas::Atlas& atlas_;
   std::filesystem::path atlas_dir_;
   std::map<std::string, Eigen::MatrixX3d> cache_;
+  std::map<std::pair<std::string, std::size_t>, Eigen::Isometry3d> poses_;
 };
 
 mesh::Polylines as_polylines(const std::vector<fibres::Fibre>& fibres) {
@@ -262,7 +269,7 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
         }
         const mesh::IndexedMesh wrapped = mesh::read_vtp(part->second);
         const fibres::MuscleFibres result = model.decompose(
-            wrapped.V, [&](const std::string& bone) { return poses.pose(bone, frame); });
+            wrapped.V, [&](const std::string& bone) { return poses.pose(bone, k, frame); });
         frame_seconds += result.seconds;
         add_frame(result, static_cast<int>(k), frame.time);
       }

@@ -6,7 +6,10 @@
 
 #include <Eigen/Core>
 
+#include <vector>
+
 #include "core/atlas/atlas.h"
+#include "core/fibres/fibre_set.h"
 #include "core/mesh/mesh.h"
 
 namespace mmm::fibres {
@@ -43,6 +46,18 @@ struct MuscleAxes {
   Eigen::Vector3d insertion_centre;
   Eigen::Vector3d axis;
   Eigen::Vector3d reference;
+};
+
+// What the contour methods (slicing, harmonic, mass-spring) return: the
+// fibres, the contours they went through, levels without a closed contour
+// (interpolated from their neighbours), fibre points moved into the muscle
+// (keep_inside.h) and the muscle's axes.
+struct ContourFibres {
+  std::vector<Fibre> fibres;
+  std::vector<Contour> contours;
+  int interpolated_contours = 0;
+  int moved_inside = 0;
+  MuscleAxes axes;
 };
 
 // Throws InvalidInputError when a point set is empty or not finite, or the

@@ -8,7 +8,10 @@
 
 #include "core/errors.h"
 #include "core/fibres/contour_map.h"
+#include "core/fibres/contour_stack.h"
 #include "core/fibres/keep_inside.h"
+#include "core/mesh/aabb_tree.h"
+#include "core/mesh/winding_number.h"
 
 namespace mmm::fibres {
 
@@ -130,35 +133,42 @@ Fibre extend_fibre(const Fibre& fibre, const Vector3d& origin_target,
   return out;
 }
 
-std::vector<Fibre> finish_fibres(const std::vector<Fibre>& mapped,
-                                 const std::vector<TemplateFibre>& templates,
-                                 const Attachments& attachments, const MuscleAxes& axes,
-                                 const mesh::WindingNumber& inside,
-                                 const DecompositionOptions& options, int* moved_inside) {
+ContourFibres contour_sections(const mesh::IndexedMesh& surface, const Eigen::VectorXd& values,
+                               const std::vector<double>& levels, const MuscleAxes& axes,
+                               int contour_points) {
+  ContourStack stack = contour_stack(surface, values, levels, axes.reference, contour_points);
+  ContourFibres result;
+  result.contours = std::move(stack.contours);
+  result.interpolated_contours = stack.interpolated;
+  result.axes = axes;
+  return result;
+}
+
+void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
+                   const std::vector<Fibre>& mapped, const std::vector<TemplateFibre>& templates,
+                   const Attachments& attachments, const DecompositionOptions& options) {
   std::vector<Vector2d> starts;
   std::vector<Vector2d> ends;
   for (const TemplateFibre& fibre : templates) {
     starts.push_back(fibre.at(0.0));
     ends.push_back(fibre.at(1.0));
   }
-  const std::vector<int> origin_of = match_ends(attachments.origin, axes, starts);
-  const std::vector<int> insertion_of = match_ends(attachments.insertion, axes, ends);
-  std::vector<Fibre> fibres;
-  fibres.reserve(mapped.size());
+  const std::vector<int> origin_of = match_ends(attachments.origin, result.axes, starts);
+  const std::vector<int> insertion_of = match_ends(attachments.insertion, result.axes, ends);
+  const mesh::AabbTree tree(surface);
+  const mesh::WindingNumber inside(tree);
+  result.fibres.clear();
+  result.fibres.reserve(mapped.size());
   for (std::size_t f = 0; f < mapped.size(); ++f) {
     const Vector3d origin_target =
-        inside.tree().closest_point(attachments.origin.row(origin_of[f]).transpose()).point;
+        tree.closest_point(attachments.origin.row(origin_of[f]).transpose()).point;
     const Vector3d insertion_target =
-        inside.tree().closest_point(attachments.insertion.row(insertion_of[f]).transpose()).point;
+        tree.closest_point(attachments.insertion.row(insertion_of[f]).transpose()).point;
     Fibre whole = extend_fibre(mapped[f], origin_target, insertion_target);
     smooth_fibre(whole, options.smoothing_passes);
-    fibres.push_back(resample_fibre(whole, options.segments));
+    result.fibres.push_back(resample_fibre(whole, options.segments));
   }
-  const int moved = keep_inside(fibres, inside, kInsideMarginMm);
-  if (moved_inside != nullptr) {
-    *moved_inside = moved;
-  }
-  return fibres;
+  result.moved_inside = keep_inside(result.fibres, inside, kInsideMarginMm);
 }
 
 void smooth_fibre(Fibre& fibre, int passes) {

@@ -9,7 +9,7 @@
 #include "core/fibres/decomposition.h"
 #include "core/fibres/fibre_set.h"
 #include "core/fibres/fibre_templates.h"
-#include "core/mesh/winding_number.h"
+#include "core/mesh/mesh.h"
 
 namespace mmm::fibres {
 
@@ -34,18 +34,22 @@ std::vector<int> match_ends(const Eigen::MatrixX3d& points, const MuscleAxes& ax
 Fibre extend_fibre(const Fibre& fibre, const Eigen::Vector3d& origin_target,
                    const Eigen::Vector3d& insertion_target);
 
-// Mapped fibres finished: each end extended to the muscle surface point
-// nearest its own attachment point (match_ends on the templates' end
-// positions), smoothed (options.smoothing_passes), resampled to
-// options.segments and kept inside the muscle (keep_inside.h, margin
-// kInsideMarginMm). `moved_inside` (when given) counts the points that had to
-// be moved in.
+// A result holding `axes` and the contour stack of `values` at `levels`
+// (contour_stack.h), started on the side of axes.reference.
+ContourFibres contour_sections(const mesh::IndexedMesh& surface, const Eigen::VectorXd& values,
+                               const std::vector<double>& levels, const MuscleAxes& axes,
+                               int contour_points);
+
+// result.fibres from the fibres `mapped` through result.contours for
+// `templates`: each end extended to the surface point nearest its own
+// attachment point (match_ends on the templates' end positions), smoothed
+// (options.smoothing_passes), resampled to options.segments and kept inside
+// `surface` (keep_inside.h, margin kInsideMarginMm; counted in
+// result.moved_inside).
 constexpr double kInsideMarginMm = 0.5;
-std::vector<Fibre> finish_fibres(const std::vector<Fibre>& mapped,
-                                 const std::vector<TemplateFibre>& templates,
-                                 const Attachments& attachments, const MuscleAxes& axes,
-                                 const mesh::WindingNumber& inside,
-                                 const DecompositionOptions& options, int* moved_inside = nullptr);
+void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
+                   const std::vector<Fibre>& mapped, const std::vector<TemplateFibre>& templates,
+                   const Attachments& attachments, const DecompositionOptions& options);
 
 // `passes` of Laplacian smoothing (each interior point moved half-way to
 // the mean of its neighbours), ends fixed.

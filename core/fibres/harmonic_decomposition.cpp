@@ -3,7 +3,6 @@
 #include <string>
 
 #include "core/errors.h"
-#include "core/fibres/contour_stack.h"
 #include "core/fibres/fibre_mapping.h"
 #include "core/fibres/fibre_templates.h"
 
@@ -17,22 +16,16 @@ HarmonicResult harmonic_fibres(const mesh::IndexedMesh& surface, const Attachmen
                             " values for a surface of " + std::to_string(surface.V.rows()) +
                             " vertices, or a value that is not finite; recompute it for this mesh");
   }
-  HarmonicResult result;
-  result.axes = muscle_axes(surface, attachments);
   std::vector<double> levels;
   for (int k = 0; k <= options.segments; ++k) {
     levels.push_back(kHarmonicEndLevel + (1.0 - 2.0 * kHarmonicEndLevel) * k / options.segments);
   }
-  ContourStack stack =
-      contour_stack(surface, field, levels, result.axes.reference, options.contour_points);
-  result.interpolated_contours = stack.interpolated;
-  result.contours = std::move(stack.contours);
+  HarmonicResult result = contour_sections(
+      surface, field, levels, muscle_axes(surface, attachments), options.contour_points);
   const std::vector<TemplateFibre> templates =
       fibre_template(options.architecture, options.fibres, attachments.narrow_at_insertion());
-  const mesh::AabbTree tree(surface);
-  const mesh::WindingNumber inside(tree);
-  result.fibres = finish_fibres(fibres_through_contours(result.contours, templates), templates,
-                                attachments, result.axes, inside, options, &result.moved_inside);
+  finish_fibres(result, surface, fibres_through_contours(result.contours, templates), templates,
+                attachments, options);
   return result;
 }
 

@@ -15,13 +15,7 @@
 
 namespace mmm::fibres {
 
-struct HarmonicResult {
-  std::vector<Fibre> fibres;
-  std::vector<Contour> contours;
-  int interpolated_contours = 0;
-  int moved_inside = 0;  // fibre points moved into the muscle (keep_inside.h)
-  MuscleAxes axes;
-};
+using HarmonicResult = ContourFibres;
 
 constexpr double kHarmonicEndLevel = 0.01;
 

@@ -4,12 +4,9 @@
 #include <string>
 
 #include "core/errors.h"
-#include "core/fibres/contour_stack.h"
 #include "core/fibres/fibre_mapping.h"
 #include "core/fibres/mass_spring.h"
 #include "core/fibres/slicing_decomposition.h"
-#include "core/mesh/aabb_tree.h"
-#include "core/mesh/winding_number.h"
 
 namespace mmm::fibres {
 
@@ -21,13 +18,10 @@ MassSpringDecomposition mass_spring_decomposition(const mesh::IndexedMesh& surfa
     throw InvalidInputError("mass-spring decomposition: " + std::to_string(options.fibres) +
                             " fibres asked for; the grid needs at least 3 x 3 = 9");
   }
-  MassSpringDecomposition result;
-  result.axes = muscle_axes(surface, attachments);
-  const SlicingPlanes planes = slicing_planes(surface, attachments, result.axes, options.segments);
-  ContourStack stack = contour_stack(surface, planes.vertex_heights, planes.levels,
-                                     result.axes.reference, options.contour_points);
-  result.interpolated_contours = stack.interpolated;
-  result.contours = std::move(stack.contours);
+  const MuscleAxes axes = muscle_axes(surface, attachments);
+  const SlicingPlanes planes = slicing_planes(surface, attachments, axes, options.segments);
+  MassSpringDecomposition result{contour_sections(surface, planes.vertex_heights, planes.levels,
+                                                  axes, options.contour_points)};
   MassSpringOptions spring;
   spring.grid = static_cast<int>(std::lround(std::sqrt(static_cast<double>(options.fibres))));
   const MassSpringResult balanced = mass_spring_fibres(result.contours, spring);
@@ -42,10 +36,7 @@ MassSpringDecomposition mass_spring_decomposition(const mesh::IndexedMesh& surfa
       templates.push_back({at, {at, at, at}});
     }
   }
-  const mesh::AabbTree tree(surface);
-  const mesh::WindingNumber inside(tree);
-  result.fibres = finish_fibres(balanced.fibres, templates, attachments, result.axes, inside,
-                                options, &result.moved_inside);
+  finish_fibres(result, surface, balanced.fibres, templates, attachments, options);
   return result;
 }
 

@@ -14,14 +14,9 @@
 
 namespace mmm::fibres {
 
-struct MassSpringDecomposition {
-  std::vector<Fibre> fibres;
-  std::vector<Contour> contours;
-  int interpolated_contours = 0;
-  int moved_inside = 0;
+struct MassSpringDecomposition : ContourFibres {
   int iterations = 0;  // of the mass-spring balance
   bool converged = false;
-  MuscleAxes axes;
 };
 
 // Throws InvalidInputError as slicing_fibres, and for fewer than 9 fibres.

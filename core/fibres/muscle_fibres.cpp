@@ -136,28 +136,21 @@ MuscleFibres MuscleFibreModel::decompose_checked(const Eigen::MatrixX3d& positio
   mesh::IndexedMesh surface{positions, rest_.F};
   MuscleFibres out;
   out.attachments = posed_attachments(samples_, pose);
+  const auto take = [&out](ContourFibres&& r) {
+    out.fibres = std::move(r.fibres);
+    out.moved_inside = r.moved_inside;
+    out.interpolated_contours = r.interpolated_contours;
+  };
   switch (method_) {
-    case DecompositionMethod::kSlicing: {
-      SlicingResult r = slicing_fibres(surface, out.attachments, options_);
-      out.fibres = std::move(r.fibres);
-      out.moved_inside = r.moved_inside;
-      out.interpolated_contours = r.interpolated_contours;
+    case DecompositionMethod::kSlicing:
+      take(slicing_fibres(surface, out.attachments, options_));
       break;
-    }
-    case DecompositionMethod::kHarmonic: {
-      HarmonicResult r = harmonic_fibres(surface, out.attachments, field_, options_);
-      out.fibres = std::move(r.fibres);
-      out.moved_inside = r.moved_inside;
-      out.interpolated_contours = r.interpolated_contours;
+    case DecompositionMethod::kHarmonic:
+      take(harmonic_fibres(surface, out.attachments, field_, options_));
       break;
-    }
-    case DecompositionMethod::kMassSpring: {
-      MassSpringDecomposition r = mass_spring_decomposition(surface, out.attachments, options_);
-      out.fibres = std::move(r.fibres);
-      out.moved_inside = r.moved_inside;
-      out.interpolated_contours = r.interpolated_contours;
+    case DecompositionMethod::kMassSpring:
+      take(mass_spring_decomposition(surface, out.attachments, options_));
       break;
-    }
     case DecompositionMethod::kCadaver: {
       std::vector<Fibre> measured;
       if (measured_.empty()) {

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include "core/fibres/contour_stack.h"
 #include "core/fibres/fibre_mapping.h"
 
 namespace mmm::fibres {
@@ -35,19 +34,14 @@ SlicingPlanes slicing_planes(const mesh::IndexedMesh& surface, const Attachments
 SlicingResult slicing_fibres(const mesh::IndexedMesh& surface, const Attachments& attachments,
                              const DecompositionOptions& options) {
   validate(options);
-  SlicingResult result;
-  result.axes = muscle_axes(surface, attachments);
-  const SlicingPlanes planes = slicing_planes(surface, attachments, result.axes, options.segments);
-  ContourStack stack = contour_stack(surface, planes.vertex_heights, planes.levels,
-                                     result.axes.reference, options.contour_points);
-  result.interpolated_contours = stack.interpolated;
-  result.contours = std::move(stack.contours);
+  const MuscleAxes axes = muscle_axes(surface, attachments);
+  const SlicingPlanes planes = slicing_planes(surface, attachments, axes, options.segments);
+  SlicingResult result =
+      contour_sections(surface, planes.vertex_heights, planes.levels, axes, options.contour_points);
   const std::vector<TemplateFibre> templates =
       fibre_template(options.architecture, options.fibres, attachments.narrow_at_insertion());
-  const mesh::AabbTree tree(surface);
-  const mesh::WindingNumber inside(tree);
-  result.fibres = finish_fibres(fibres_through_contours(result.contours, templates), templates,
-                                attachments, result.axes, inside, options, &result.moved_inside);
+  finish_fibres(result, surface, fibres_through_contours(result.contours, templates), templates,
+                attachments, options);
   return result;
 }
 

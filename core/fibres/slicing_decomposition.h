@@ -24,13 +24,7 @@
 
 namespace mmm::fibres {
 
-struct SlicingResult {
-  std::vector<Fibre> fibres;
-  std::vector<Contour> contours;  // the sections the fibres went through
-  int interpolated_contours = 0;  // planes with no closed section
-  int moved_inside = 0;           // fibre points moved into the muscle (keep_inside.h)
-  MuscleAxes axes;
-};
+using SlicingResult = ContourFibres;
 
 // The heights (along axes.axis, from axes.origin_centre) of the
 // segments + 1 planes of step 2, and the height of every surface vertex.
