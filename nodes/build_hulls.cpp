@@ -6,10 +6,9 @@
 
 #include "core/atlas/atlas_io.h"
 #include "core/directory_bundle.h"
-#include "core/errors.h"
 #include "core/wrapping/muscle_hulls.h"
 #include "core/wrapping/muscle_wrapping.h"
-#include "nodes/name_list.h"
+#include "nodes/muscle_selection.h"
 
 namespace mmm::nodes {
 
@@ -40,19 +39,8 @@ void BuildHulls::run(workflow::NodeContext& context) {
   const std::filesystem::path atlas_dir = context.scratch_dir() / "atlas";
   unpack_directory(context.input_bytes("atlas"), atlas_dir, "input 'atlas'");
   const atlas::Atlas atlas = atlas::read_atlas(atlas_dir);
-  std::vector<const atlas::Muscle*> muscles;
-  const std::vector<std::string> names = split_names(context.text("muscles"));
-  for (const std::string& name : names) {
-    const atlas::Muscle* muscle = atlas.find_muscle(name);
-    if (muscle == nullptr) {
-      throw InvalidInputError("build_hulls: parameter 'muscles': the atlas has no muscle '" + name +
-                              "'");
-    }
-    muscles.push_back(muscle);
-  }
-  if (names.empty()) {
-    for (const atlas::Muscle& muscle : atlas.muscles) muscles.push_back(&muscle);
-  }
+  const std::vector<const atlas::Muscle*> muscles =
+      selected_muscles(atlas, context.text("muscles"), "build_hulls");
   const Eigen::Index target_faces = context.integer("target_faces");
   const Eigen::Index hull_faces = context.integer("hull_faces");
   std::vector<wrapping::MuscleHull> hulls;

@@ -24,6 +24,7 @@
 #include "core/wrapping/muscle_hulls.h"
 #include "core/wrapping/muscle_wrapping.h"
 #include "nodes/fibre_picture.h"
+#include "nodes/muscle_selection.h"
 #include "nodes/name_list.h"
 
 namespace mmm::nodes {
@@ -95,8 +96,7 @@ class BonePoses {
                               "' at time " + fixed(frame.time, 4) + "; hint: wrap the same atlas");
     }
     const mesh::IndexedMesh posed = mesh::read_vtp(part->second);
-    const Eigen::Isometry3d fitted =
-        fit::rigid_fit(rest_level(bone, posed.V.rows()), posed.V).rigid;
+    Eigen::Isometry3d fitted = fit::rigid_fit(rest_level(bone, posed.V.rows()), posed.V).rigid;
     poses_.emplace(std::pair{bone, index}, fitted);
     return fitted;
   }
@@ -182,18 +182,8 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
   const std::filesystem::path atlas_dir = context.scratch_dir() / "atlas";
   unpack_directory(context.input_bytes("atlas"), atlas_dir, "input 'atlas'");
   const atlas::Atlas atlas = atlas::read_atlas(atlas_dir);
-  std::vector<const atlas::Muscle*> muscles;
-  for (const std::string& name : split_names(context.text("muscles"))) {
-    const atlas::Muscle* muscle = atlas.find_muscle(name);
-    if (muscle == nullptr) {
-      throw InvalidInputError("decompose_fibres: parameter 'muscles': the atlas has no muscle '" +
-                              name + "'");
-    }
-    muscles.push_back(muscle);
-  }
-  if (muscles.empty()) {
-    for (const atlas::Muscle& muscle : atlas.muscles) muscles.push_back(&muscle);
-  }
+  const std::vector<const atlas::Muscle*> muscles =
+      selected_muscles(atlas, context.text("muscles"), "decompose_fibres");
   const DecompositionMethod default_method = *fibres::method_from_name(context.text("method"));
   const auto overrides = method_overrides(context.text("methods"), atlas);
   fibres::DecompositionOptions options;
