@@ -1,11 +1,12 @@
 // Muscle decomposition into fibres on the default atlas (Visible Human Female
 // surfaces at the wrapping resolution, 10K faces). (1) Quality of every
 // method on every muscle (81 fibres x 20 segments): fibre points inside the
-// muscle, distance of the fibre ends from their attachment areas beside the
-// gap between each area and the muscle surface (a muscle surface that stops
-// short of the bone, its tendon not segmented, leaves that gap), coverage of
-// the areas, spacing and length spread, t-polynomial fit error, points that
-// had to be moved inside. (2) Time per decomposition (median of 11) for the
+// muscle, distance of the fibre ends from the muscle's end patches (where it
+// lies on its bones, or its end cap where the segmentation stops at a tendon;
+// end_patches.h) and coverage of the patches, the tendon gap from each patch
+// to its bone area beside the median end distance from the bone area itself,
+// spacing and length spread, t-polynomial fit error, points that had to be
+// moved inside. (2) Time per decomposition (median of 11) for the
 // gluteus medius and the iliacus beside the reference implementation's
 // (VPHOP D10.2, section 3.4.3), and 256 fibres x 50 segments by slicing.
 // (3) Google Benchmark: the same decompositions.
@@ -89,13 +90,16 @@ double median(std::vector<double> values) {
   return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-// Closest distance from an attachment area's points to the muscle surface.
-double surface_gap(const mmm::mesh::AabbTree& tree, const Eigen::MatrixX3d& points) {
-  double gap = 1e300;
-  for (Eigen::Index i = 0; i < points.rows(); ++i) {
-    gap = std::min(gap, std::sqrt(tree.closest_point(points.row(i).transpose()).squared_distance));
+// Median over the fibres of the distance from one end (first or last point)
+// to the nearest of `points`.
+double end_distance_median(const std::vector<fibres::Fibre>& fibres, const Eigen::MatrixX3d& points,
+                           bool last) {
+  std::vector<double> distances;
+  for (const fibres::Fibre& fibre : fibres) {
+    const Eigen::RowVector3d end = fibre.row(last ? fibre.rows() - 1 : 0);
+    distances.push_back(std::sqrt((points.rowwise() - end).rowwise().squaredNorm().minCoeff()));
   }
-  return gap;
+  return median(distances);
 }
 
 std::string fixed(double value, int decimals) {
@@ -107,37 +111,43 @@ std::string fixed(double value, int decimals) {
 nlohmann::json quality_table(std::ostringstream& out) {
   out << "== Quality: 81 fibres x 20 segments, every muscle and method (wrapping resolution) ==\n"
       << "inside: fibre points inside the muscle or within 0.5 mm of it; ends: median distance "
-         "of the origin / insertion ends from their area (mm); gap: closest approach of the area "
-         "to the muscle surface (mm); cover: share of area points within 5 mm of a fibre end; "
-         "moved: points moved inside\n";
+         "of the origin / insertion ends from the muscle's end patch (mm); cover: share of patch "
+         "vertices within 5 mm of a fibre end; tendon: closest approach of the bone area to its "
+         "patch (mm, the unsegmented tendon); to bone: median distance of the ends from the bone "
+         "area (mm); moved: points moved inside\n";
   out << std::left << std::setw(30) << "muscle" << std::setw(12) << "method" << std::right
-      << std::setw(8) << "inside%" << std::setw(14) << "ends o/i" << std::setw(13) << "gap o/i"
-      << std::setw(13) << "cover o/i" << std::setw(9) << "spac.cv" << std::setw(9) << "len mm"
+      << std::setw(8) << "inside%" << std::setw(12) << "ends o/i" << std::setw(13) << "cover o/i"
+      << std::setw(14) << "tendon o/i" << std::setw(14) << "to bone o/i" << std::setw(9) << "spac.cv" << std::setw(9) << "len mm"
       << std::setw(8) << "len.cv" << std::setw(8) << "fit mm" << std::setw(7) << "moved"
       << std::setw(8) << "ms"
       << "\n";
   nlohmann::json rows = nlohmann::json::array();
   std::map<DecompositionMethod, std::vector<double>> inside;
-  std::map<DecompositionMethod, std::vector<double>> excess;
+  std::map<DecompositionMethod, std::vector<double>> ends;
+  std::map<DecompositionMethod, std::vector<double>> cover;
   for (const mmm::atlas::Muscle& muscle : atlas().atlas.muscles) {
     for (const DecompositionMethod method : kMethods) {
       const auto m = model(muscle.name, method, 81, 20);
       const fibres::MuscleFibres result = m->decompose_at_rest();
       const fibres::FibreQuality q = fibres::measure_fibre_quality(
           m->rest(), result.fibres, result.attachments.origin, result.attachments.insertion);
-      const mmm::mesh::AabbTree tree(m->rest());
-      const double gap_o = surface_gap(tree, result.attachments.origin);
-      const double gap_i = surface_gap(tree, result.attachments.insertion);
+      const double gap_o = result.origin_gap_mm;
+      const double gap_i = result.insertion_gap_mm;
+      const double bone_o = end_distance_median(result.fibres, result.bone_areas.origin, false);
+      const double bone_i = end_distance_median(result.fibres, result.bone_areas.insertion, true);
       inside[method].push_back(q.inside_fraction);
-      excess[method].push_back(q.origin_end_distance_median_mm - gap_o);
-      excess[method].push_back(q.insertion_end_distance_median_mm - gap_i);
+      ends[method].push_back(q.origin_end_distance_median_mm);
+      ends[method].push_back(q.insertion_end_distance_median_mm);
+      cover[method].push_back(q.origin_coverage);
+      cover[method].push_back(q.insertion_coverage);
       const std::string name(fibres::method_name(method));
       out << std::left << std::setw(30) << muscle.name << std::setw(12) << name << std::right
-          << std::setw(8) << fixed(100.0 * q.inside_fraction, 2) << std::setw(14)
+          << std::setw(8) << fixed(100.0 * q.inside_fraction, 2) << std::setw(12)
           << (fixed(q.origin_end_distance_median_mm, 1) + " / " +
               fixed(q.insertion_end_distance_median_mm, 1))
-          << std::setw(13) << (fixed(gap_o, 1) + " / " + fixed(gap_i, 1)) << std::setw(13)
-          << (fixed(q.origin_coverage, 2) + " / " + fixed(q.insertion_coverage, 2)) << std::setw(9)
+          << std::setw(13) << (fixed(q.origin_coverage, 2) + " / " + fixed(q.insertion_coverage, 2))
+          << std::setw(14) << (fixed(gap_o, 1) + " / " + fixed(gap_i, 1)) << std::setw(14)
+          << (fixed(bone_o, 1) + " / " + fixed(bone_i, 1)) << std::setw(9)
           << fixed(q.spacing_cv, 2) << std::setw(9) << fixed(q.length_median_mm, 0) << std::setw(8)
           << fixed(q.length_cv, 2) << std::setw(8) << fixed(q.fit_error_mean_mm, 2) << std::setw(7)
           << result.moved_inside << std::setw(8) << fixed(1000.0 * result.seconds, 1)
@@ -147,6 +157,8 @@ nlohmann::json quality_table(std::ostringstream& out) {
       row["method"] = name;
       row["origin_gap_mm"] = gap_o;
       row["insertion_gap_mm"] = gap_i;
+      row["origin_to_bone_median_mm"] = bone_o;
+      row["insertion_to_bone_median_mm"] = bone_i;
       row["moved_inside"] = result.moved_inside;
       row["stand_in_measured"] = result.stand_in_measured;
       row["ms"] = 1000.0 * result.seconds;
@@ -154,11 +166,16 @@ nlohmann::json quality_table(std::ostringstream& out) {
       rows.push_back(row);
     }
   }
-  out << "over all muscles, per method: lowest inside %, median of (end distance - gap) mm\n";
+  out << "over all muscles, per method: lowest inside %; end distance median (mm): median and "
+         "largest over the muscles' ends; coverage: median and lowest\n";
   for (const DecompositionMethod method : kMethods) {
+    const auto& e = ends[method];
+    const auto& c = cover[method];
     out << "  " << std::left << std::setw(12) << fibres::method_name(method) << std::right
         << fixed(100.0 * *std::min_element(inside[method].begin(), inside[method].end()), 2)
-        << " %   " << fixed(median(excess[method]), 2) << " mm\n";
+        << " %   ends " << fixed(median(e), 2) << " / " << fixed(*std::max_element(e.begin(), e.end()), 2)
+        << " mm   cover " << fixed(median(c), 2) << " / "
+        << fixed(*std::min_element(c.begin(), c.end()), 2) << "\n";
   }
   return rows;
 }

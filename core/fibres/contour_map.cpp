@@ -1,6 +1,7 @@
 #include "core/fibres/contour_map.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -175,6 +176,46 @@ Contour consistent_contour(const Eigen::MatrixX3d& loop, const Vector3d& axis,
     best_point = oriented.row(far).transpose();
   }
   return resample_closed(oriented, best_segment, best_point, count);
+}
+
+Contour align_start(const Contour& contour, const Contour& neighbour) {
+  const Index n = contour.rows();
+  if (n < 3 || neighbour.rows() != n) {
+    throw InvalidInputError("align_start: contours of " + std::to_string(n) + " and " +
+                            std::to_string(neighbour.rows()) +
+                            " points; both need the same count, at least three");
+  }
+  const Eigen::MatrixX3d a = contour.rowwise() - contour.colwise().mean();
+  const Eigen::MatrixX3d b = neighbour.rowwise() - neighbour.colwise().mean();
+  // cost(s) = sum_i |a(i + s) - b(i)|^2 for every whole shift s.
+  Eigen::VectorXd cost(n);
+  for (Index s = 0; s < n; ++s) {
+    double sum = 0.0;
+    for (Index i = 0; i < n; ++i) {
+      sum += (a.row((i + s) % n) - b.row(i)).squaredNorm();
+    }
+    cost(s) = sum;
+  }
+  Index best = 0;
+  cost.minCoeff(&best);
+  // The fractional part from the parabola through the best shift's neighbours.
+  const double before = cost((best + n - 1) % n);
+  const double after = cost((best + 1) % n);
+  const double curvature = before - 2.0 * cost(best) + after;
+  const double fraction =
+      curvature > 0.0 ? std::clamp(0.5 * (before - after) / curvature, -0.5, 0.5) : 0.0;
+  if (best == 0 && fraction == 0.0) {
+    return contour;
+  }
+  Contour out(n, 3);
+  for (Index i = 0; i < n; ++i) {
+    const double at = static_cast<double>(i + best) + fraction;
+    const double whole = std::floor(at);
+    const double w = at - whole;
+    const Index k = ((static_cast<Index>(whole) % n) + n) % n;
+    out.row(i) = (1.0 - w) * contour.row(k) + w * contour.row((k + 1) % n);
+  }
+  return out;
 }
 
 }  // namespace mmm::fibres

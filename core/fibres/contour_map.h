@@ -35,4 +35,13 @@ Eigen::RowVectorXd square_mean_value_weights(const Eigen::Vector2d& uv, int coun
 Contour consistent_contour(const Eigen::MatrixX3d& loop, const Eigen::Vector3d& axis,
                            const Eigen::Vector3d& reference, int count);
 
+// `contour` with its start moved along itself (a cyclic shift by a
+// fractional number of its equal arc-length steps) to where it best matches
+// `neighbour` (same point count): the shift minimising the summed squared
+// distances between corresponding points, both loops centred on their mean.
+// Chained from contour to contour, it keeps the start from jumping across a
+// muscle whose cross-sections tilt or twist. Throws InvalidInputError for
+// different point counts or fewer than three points.
+Contour align_start(const Contour& contour, const Contour& neighbour);
+
 }  // namespace mmm::fibres

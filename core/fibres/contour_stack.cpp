@@ -1,5 +1,6 @@
 #include "core/fibres/contour_stack.h"
 
+#include <algorithm>
 #include <optional>
 #include <string>
 
@@ -8,6 +9,39 @@
 #include "core/fibres/iso_lines.h"
 
 namespace mmm::fibres {
+namespace {
+
+// The closed contour nearest the middle level keeps its start (on the side
+// of the reference); every other one takes the start that best matches its
+// already aligned neighbour toward the middle (align_start).
+void align_starts(std::vector<std::optional<Contour>>& found) {
+  const std::size_t n = found.size();
+  std::size_t anchor = n;
+  for (std::size_t step = 0; step < n && anchor == n; ++step) {
+    for (const std::size_t k : {n / 2 - std::min(step, n / 2), n / 2 + step}) {
+      if (k < n && found[k]) {
+        anchor = k;
+        break;
+      }
+    }
+  }
+  const Contour* previous = &*found[anchor];
+  for (std::size_t k = anchor + 1; k < n; ++k) {
+    if (found[k]) {
+      found[k] = align_start(*found[k], *previous);
+      previous = &*found[k];
+    }
+  }
+  previous = &*found[anchor];
+  for (std::size_t k = anchor; k-- > 0;) {
+    if (found[k]) {
+      found[k] = align_start(*found[k], *previous);
+      previous = &*found[k];
+    }
+  }
+}
+
+}  // namespace
 
 ContourStack contour_stack(const mesh::IndexedMesh& surface, const Eigen::VectorXd& values,
                            const std::vector<double>& levels, const Eigen::Vector3d& reference,
@@ -27,6 +61,7 @@ ContourStack contour_stack(const mesh::IndexedMesh& surface, const Eigen::Vector
                             " levels cut the muscle in a closed loop; is the surface closed and "
                             "do its attachment areas lie at its two ends?");
   }
+  align_starts(found);
   ContourStack stack;
   for (std::size_t k = 0; k < levels.size(); ++k) {
     if (found[k]) {

@@ -11,28 +11,17 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "core/fibres/decomposition.h"
+#include "core/fibres/end_patches.h"
 #include "core/mesh/mesh.h"
 
 namespace mmm::fibres {
 
-// The surface vertices on each attachment area: those within `distance_mm`
-// of one of its points and nearer to it than to the other area; when fewer
-// than 3 (a muscle surface that stops short of its bone), the 3 nearest to
-// the area's points that the other area does not hold. Throws
-// InvalidInputError when an attachment has no points.
-struct AttachmentVertices {
-  std::vector<int> origin;
-  std::vector<int> insertion;
-};
-AttachmentVertices attachment_vertices(const mesh::IndexedMesh& surface,
-                                       const Attachments& attachments, double distance_mm = 3.0);
-
 // The field (one value per vertex, in [0, 1] up to the cotangent weights'
-// discrete maximum principle). Throws InvalidInputError for an empty
+// discrete maximum principle), 0 on ends.origin and 1 on ends.insertion
+// (end_patches.h). Throws InvalidInputError for an empty
 // attachment set or overlapping ones, SolverError when the system cannot be
 // factored (a piece of the surface touching neither attachment).
 Eigen::VectorXd harmonic_field(const mesh::IndexedMesh& surface,
-                               const AttachmentVertices& attachments);
+                               const EndPatches& ends);
 
 }  // namespace mmm::fibres

@@ -104,14 +104,15 @@ MuscleFibreModel::MuscleFibreModel(std::string name, mesh::IndexedMesh rest,
     throw InvalidInputError("muscle " + name_ +
                             ": one measured fibre; the cadaver method needs at least two");
   }
-  if (method_ == DecompositionMethod::kHarmonic || method_ == DecompositionMethod::kCadaver) {
-    const auto start = Clock::now();
-    try {
-      field_ = harmonic_field(rest_, attachment_vertices(rest_, posed_attachments(samples_)));
-    } catch (const InvalidInputError& error) {
-      throw InvalidInputError("muscle " + name_ + ": " + error.what());
+  try {
+    ends_ = fibres::end_patches(rest_, posed_attachments(samples_));
+    if (method_ == DecompositionMethod::kHarmonic || method_ == DecompositionMethod::kCadaver) {
+      const auto start = Clock::now();
+      field_ = harmonic_field(rest_, ends_);
+      field_seconds_ = seconds_since(start);
     }
-    field_seconds_ = seconds_since(start);
+  } catch (const InvalidInputError& error) {
+    throw InvalidInputError("muscle " + name_ + ": " + error.what());
   }
 }
 
@@ -135,7 +136,10 @@ MuscleFibres MuscleFibreModel::decompose_checked(const Eigen::MatrixX3d& positio
   const auto start = Clock::now();
   mesh::IndexedMesh surface{positions, rest_.F};
   MuscleFibres out;
-  out.attachments = posed_attachments(samples_, pose);
+  out.bone_areas = posed_attachments(samples_, pose);
+  out.attachments = patch_attachments(ends_, positions, out.bone_areas);
+  out.origin_gap_mm = patch_gap(ends_.origin, positions, out.bone_areas.origin);
+  out.insertion_gap_mm = patch_gap(ends_.insertion, positions, out.bone_areas.insertion);
   const auto take = [&out](ContourFibres&& r) {
     out.fibres = std::move(r.fibres);
     out.moved_inside = r.moved_inside;

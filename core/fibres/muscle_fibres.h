@@ -3,7 +3,10 @@
 // of a wrapped motion. What does not change from frame to frame is prepared
 // once: the attachment samples (carried by their bones per frame) and, for
 // the harmonic and cadaver methods, the harmonic field of the rest surface
-// (a wrapped muscle keeps its vertices, so the field stays valid).
+// (a wrapped muscle keeps its vertices, so the field stays valid), and the
+// muscle's end patches (end_patches.h): the fibres end on the muscle's own
+// surface where it lies on its bones or, where the segmentation stops at a
+// tendon, on its end cap.
 //
 //   slicing      slicing_decomposition.h
 //   harmonic     harmonic_decomposition.h
@@ -23,6 +26,7 @@
 
 #include "core/fibres/atlas_attachments.h"
 #include "core/fibres/decomposition.h"
+#include "core/fibres/end_patches.h"
 #include "core/fibres/fibre_set.h"
 
 namespace mmm::fibres {
@@ -33,7 +37,15 @@ std::optional<DecompositionMethod> method_from_name(std::string_view name);
 
 struct MuscleFibres {
   std::vector<Fibre> fibres;
-  Attachments attachments;  // where the ends belong, in this frame
+  // Where the ends belong in this frame: the muscle's end patches
+  // (end_patches.h) at this frame's vertex positions.
+  Attachments attachments;
+  // The atlas's attachment areas on the bones, carried by the bones' pose,
+  // and each one's closest approach to its end patch: the tendon the
+  // segmentation left out (0 where the muscle lies on the bone).
+  Attachments bone_areas;
+  double origin_gap_mm = 0.0;
+  double insertion_gap_mm = 0.0;
   int moved_inside = 0;     // fibre points moved into the muscle
   int interpolated_contours = 0;
   bool stand_in_measured = false;  // cadaver: measured fibres were stand-ins
@@ -61,6 +73,7 @@ class MuscleFibreModel {
   [[nodiscard]] const mesh::IndexedMesh& rest() const { return rest_; }
   [[nodiscard]] DecompositionMethod method() const { return method_; }
   [[nodiscard]] double field_seconds() const { return field_seconds_; }
+  [[nodiscard]] const EndPatches& end_patches() const { return ends_; }
 
  private:
   [[nodiscard]] MuscleFibres decompose_checked(const Eigen::MatrixX3d& positions,
@@ -72,6 +85,7 @@ class MuscleFibreModel {
   DecompositionMethod method_;
   DecompositionOptions options_;
   std::vector<Fibre> measured_;
+  EndPatches ends_;
   Eigen::VectorXd field_;  // harmonic and cadaver methods
   double field_seconds_ = 0.0;
 };

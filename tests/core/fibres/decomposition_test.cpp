@@ -67,8 +67,9 @@ TEST(FibreTemplates, LabelsFillTheSquareAndTemplatesStayInIt) {
 
 TEST(HarmonicField, IsTheHeightOnACylinder) {
   const mesh::IndexedMesh cylinder = testing::ringed_cylinder(kRadius, kLength, 48, 40);
-  const AttachmentVertices ends =
-      attachment_vertices(cylinder, testing::cylinder_attachments(kRadius, kLength), 1.5);
+  const EndPatches ends =
+      end_patches(cylinder, testing::cylinder_attachments(kRadius, kLength), 1.5);
+  EXPECT_LT(ends.origin_gap_mm, 1e-9);
   EXPECT_EQ(ends.origin.size(), 49U);  // the bottom ring and the cap's centre
   EXPECT_EQ(ends.insertion.size(), 49U);
   const Eigen::VectorXd field = harmonic_field(cylinder, ends);
@@ -124,7 +125,7 @@ TEST(HarmonicDecomposition, ParallelFibresOfACylinder) {
   const mesh::IndexedMesh cylinder = testing::ringed_cylinder(kRadius, kLength, 48, 40);
   const Attachments attachments = testing::cylinder_attachments(kRadius, kLength);
   const Eigen::VectorXd field =
-      harmonic_field(cylinder, attachment_vertices(cylinder, attachments));
+      harmonic_field(cylinder, end_patches(cylinder, attachments));
   const HarmonicResult result = harmonic_fibres(cylinder, attachments, field);
   EXPECT_EQ(result.interpolated_contours, 0);
   // The level sets are the cylinder's cross-sections.
