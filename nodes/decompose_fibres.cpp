@@ -174,7 +174,7 @@ workflow::NodeSpec DecomposeFibres::spec() {
       .output<File>("fibres", "Folder bundle: fibres.pvd + .vtp polylines per muscle and frame")
       .output<File>("lengths", "CSV: muscle, method, fibre, frame, time (s), length (mm)")
       .output<File>("picture", "PNG: a muscle with its fibres, front and side")
-      .output<Report>("report", "Per muscle: method, quality at rest, times");
+      .output<Report>("report", "Per muscle: method, quality at rest, worst inside fraction over the frames, tendon gaps, times");
 }
 
 void DecomposeFibres::run(workflow::NodeContext& context) {
@@ -246,6 +246,7 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
       }
     };
     double frame_seconds = 0.0;
+    double frames_inside = 1.0;  // the worst frame's inside fraction, against that frame's surface
     if (frames.empty()) {
       add_frame(rest, 0, 0.0);
     } else {
@@ -261,6 +262,11 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
         const fibres::MuscleFibres result = model.decompose(
             wrapped.V, [&](const std::string& bone) { return poses.pose(bone, k, frame); });
         frame_seconds += result.seconds;
+        frames_inside = std::min(
+            frames_inside, fibres::measure_fibre_quality(wrapped, result.fibres,
+                                                         result.attachments.origin,
+                                                         result.attachments.insertion)
+                               .inside_fraction);
         add_frame(result, static_cast<int>(k), frame.time);
       }
     }
@@ -273,6 +279,12 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
     row["field_ms"] = 1000.0 * model.field_seconds();
     row["frames"] = frames.size();
     row["frames_ms"] = 1000.0 * frame_seconds;
+    row["frames_min_inside_fraction"] = frames_inside;
+    worst_inside = std::min(worst_inside, frames_inside);
+    // The tendons the segmentation left out: from the muscle's end patches
+    // (where the fibres end) to the bone areas, at rest.
+    row["origin_tendon_gap_mm"] = rest.origin_gap_mm;
+    row["insertion_tendon_gap_mm"] = rest.insertion_gap_mm;
     rows.push_back(row);
   }
   if (worst_inside < 0.99) {

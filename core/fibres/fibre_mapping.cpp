@@ -1,5 +1,6 @@
 #include "core/fibres/fibre_mapping.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -57,22 +58,21 @@ Eigen::MatrixX2d unit_layout(const Eigen::MatrixX2d& plane) {
 
 }  // namespace
 
-std::vector<int> match_ends(const Eigen::MatrixX3d& points, const MuscleAxes& axes,
-                            const std::vector<Vector2d>& ends) {
+std::vector<int> match_ends(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& ends) {
   if (points.rows() == 0) {
     throw InvalidInputError("match_ends: the attachment area has no points");
   }
-  const Vector3d across = axes.axis.cross(axes.reference);
-  Eigen::MatrixX2d plane(points.rows(), 2);
-  plane.col(0) = points * axes.reference;
-  plane.col(1) = points * across;
-  const Eigen::MatrixX2d area = unit_layout(plane);
-  Eigen::MatrixX2d end_plane(static_cast<Index>(ends.size()), 2);
-  for (std::size_t i = 0; i < ends.size(); ++i) {
-    end_plane.row(static_cast<Index>(i)) = ends[i].transpose();
+  std::vector<int> chosen(static_cast<std::size_t>(ends.rows()), 0);
+  if (ends.rows() == 0) {
+    return chosen;
   }
-  const Eigen::MatrixX2d wanted = ends.empty() ? end_plane : unit_layout(end_plane);
-  std::vector<int> chosen(ends.size(), 0);
+  // The area's principal plane: its two directions of largest spread.
+  const Eigen::RowVector3d centre = points.colwise().mean();
+  const Eigen::MatrixX3d centred = points.rowwise() - centre;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(centred.transpose() * centred);
+  const Eigen::Matrix<double, 3, 2> plane = solver.eigenvectors().rightCols<2>();
+  const Eigen::MatrixX2d area = unit_layout(centred * plane);
+  const Eigen::MatrixX2d wanted = unit_layout((ends.rowwise() - centre) * plane);
   for (Index i = 0; i < wanted.rows(); ++i) {
     Index best = 0;
     (area.rowwise() - wanted.row(i)).rowwise().squaredNorm().minCoeff(&best);
@@ -145,16 +145,16 @@ ContourFibres contour_sections(const mesh::IndexedMesh& surface, const Eigen::Ve
 }
 
 void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
-                   const std::vector<Fibre>& mapped, const std::vector<TemplateFibre>& templates,
+                   const std::vector<Fibre>& mapped,
                    const Attachments& attachments, const DecompositionOptions& options) {
-  std::vector<Vector2d> starts;
-  std::vector<Vector2d> ends;
-  for (const TemplateFibre& fibre : templates) {
-    starts.push_back(fibre.at(0.0));
-    ends.push_back(fibre.at(1.0));
+  Eigen::MatrixX3d starts(static_cast<Index>(mapped.size()), 3);
+  Eigen::MatrixX3d ends(static_cast<Index>(mapped.size()), 3);
+  for (std::size_t f = 0; f < mapped.size(); ++f) {
+    starts.row(static_cast<Index>(f)) = mapped[f].row(0);
+    ends.row(static_cast<Index>(f)) = mapped[f].row(mapped[f].rows() - 1);
   }
-  const std::vector<int> origin_of = match_ends(attachments.origin, result.axes, starts);
-  const std::vector<int> insertion_of = match_ends(attachments.insertion, result.axes, ends);
+  const std::vector<int> origin_of = match_ends(attachments.origin, starts);
+  const std::vector<int> insertion_of = match_ends(attachments.insertion, ends);
   const mesh::AabbTree tree(surface);
   const mesh::WindingNumber inside(tree);
   result.fibres.clear();
@@ -169,6 +169,28 @@ void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
     result.fibres.push_back(resample_fibre(whole, options.segments));
   }
   result.moved_inside = keep_inside(result.fibres, inside, kInsideMarginMm);
+}
+
+int connect_to_nearest_attachments(std::vector<Fibre>& fibres, const mesh::IndexedMesh& surface,
+                                   const Attachments& attachments, int segments,
+                                   int smoothing_passes) {
+  const mesh::AabbTree tree(surface);
+  const mesh::WindingNumber inside(tree);
+  const auto nearest = [&tree](const Eigen::MatrixX3d& points, const Eigen::RowVector3d& end) {
+    Index best = 0;
+    (points.rowwise() - end).rowwise().squaredNorm().minCoeff(&best);
+    return tree.closest_point(points.row(best).transpose()).point;
+  };
+  for (Fibre& fibre : fibres) {
+    if (fibre.rows() < 2) {
+      throw InvalidInputError("connect_to_nearest_attachments: a fibre has fewer than two points");
+    }
+    Fibre whole = extend_fibre(fibre, nearest(attachments.origin, fibre.row(0)),
+                               nearest(attachments.insertion, fibre.row(fibre.rows() - 1)));
+    smooth_fibre(whole, smoothing_passes);
+    fibre = resample_fibre(whole, segments);
+  }
+  return keep_inside(fibres, inside, kInsideMarginMm);
 }
 
 void smooth_fibre(Fibre& fibre, int passes) {

@@ -20,13 +20,12 @@ std::vector<Fibre> fibres_through_contours(const std::vector<Contour>& contours,
                                            const std::vector<TemplateFibre>& templates);
 
 // Where each fibre end goes on an attachment area: `points` (the area's
-// samples) and `ends` (each fibre's (u, v) at that end) are both laid out in
-// the cross-section plane of `axes` (u along `reference`, v along axis x
-// reference), each stretched over [0, 1]^2 by its bounding box; each end
-// gets the index of the nearest point. So fibres keep their order and their
-// ends spread over the whole area.
-std::vector<int> match_ends(const Eigen::MatrixX3d& points, const MuscleAxes& axes,
-                            const std::vector<Eigen::Vector2d>& ends);
+// samples) and `ends` (#fibres by 3, where the fibres end before they are
+// extended) are both laid out in the area's principal plane (its two
+// directions of largest spread), each stretched over [0, 1]^2 by its
+// bounding box; each end gets the index of the nearest point. So fibres keep
+// their arrangement and their ends spread over the whole area.
+std::vector<int> match_ends(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& ends);
 
 // The fibre with an extension at each end: a quadratic Bezier from the
 // target to the fibre's end point, arriving along the fibre's own end
@@ -40,16 +39,24 @@ ContourFibres contour_sections(const mesh::IndexedMesh& surface, const Eigen::Ve
                                const std::vector<double>& levels, const MuscleAxes& axes,
                                int contour_points);
 
-// result.fibres from the fibres `mapped` through result.contours for
-// `templates`: each end extended to the surface point nearest its own
-// attachment point (match_ends on the templates' end positions), smoothed
+// result.fibres from the fibres `mapped` through result.contours: each end extended to the surface point nearest its own
+// attachment point (match_ends on the mapped fibres' end points), smoothed
 // (options.smoothing_passes), resampled to options.segments and kept inside
 // `surface` (keep_inside.h, margin kInsideMarginMm; counted in
 // result.moved_inside).
 constexpr double kInsideMarginMm = 0.5;
 void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
-                   const std::vector<Fibre>& mapped, const std::vector<TemplateFibre>& templates,
+                   const std::vector<Fibre>& mapped,
                    const Attachments& attachments, const DecompositionOptions& options);
+
+// Each fibre connected at both ends to the nearest of the attachment points
+// (the cadaver method's "connected to their nearest tendons"): extended
+// (extend_fibre) from its end to the surface point nearest that attachment
+// point, smoothed, resampled to `segments` and kept inside `surface`.
+// Returns the number of points moved inside.
+int connect_to_nearest_attachments(std::vector<Fibre>& fibres, const mesh::IndexedMesh& surface,
+                                   const Attachments& attachments, int segments,
+                                   int smoothing_passes);
 
 // `passes` of Laplacian smoothing (each interior point moved half-way to
 // the mean of its neighbours), ends fixed.

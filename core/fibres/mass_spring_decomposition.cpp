@@ -27,16 +27,7 @@ MassSpringDecomposition mass_spring_decomposition(const mesh::IndexedMesh& surfa
   const MassSpringResult balanced = mass_spring_fibres(result.contours, spring);
   result.iterations = balanced.iterations;
   result.converged = balanced.converged;
-  // The grid's own templates, in its order (fibre (i, j) at i * grid + j).
-  std::vector<TemplateFibre> templates;
-  for (int i = 0; i < spring.grid; ++i) {
-    for (int j = 0; j < spring.grid; ++j) {
-      const Eigen::Vector2d at(static_cast<double>(i) / (spring.grid - 1),
-                               static_cast<double>(j) / (spring.grid - 1));
-      templates.push_back({at, {at, at, at}});
-    }
-  }
-  finish_fibres(result, surface, balanced.fibres, templates, attachments, options);
+  finish_fibres(result, surface, balanced.fibres, attachments, options);
   return result;
 }
 

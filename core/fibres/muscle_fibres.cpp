@@ -7,6 +7,7 @@
 #include "core/errors.h"
 #include "core/fibres/cadaver_fibres.h"
 #include "core/fibres/harmonic_decomposition.h"
+#include "core/fibres/fibre_mapping.h"
 #include "core/fibres/harmonic_field.h"
 #include "core/fibres/mass_spring_decomposition.h"
 #include "core/fibres/slicing_decomposition.h"
@@ -175,6 +176,8 @@ MuscleFibres MuscleFibreModel::decompose_checked(const Eigen::MatrixX3d& positio
       cadaver.surface_fibres = side;
       cadaver.depth_layers = side;
       out.fibres = cadaver_fibres(surface, measured, cadaver).fibres;
+      out.moved_inside = connect_to_nearest_attachments(
+          out.fibres, surface, out.attachments, options_.segments, options_.smoothing_passes);
       break;
     }
   }

@@ -15,7 +15,10 @@
 //                data (Visible Human Female) has none, so without measured
 //                fibres four stand-ins are traced: the harmonic method's
 //                fibres of the first row of the template (one side of the
-//                muscle), moved onto the surface. Results say when.
+//                muscle), moved onto the surface. Results say when. Every
+//                fibre is then connected at each end to the nearest point
+//                of its end patch (fibre_mapping.h,
+//                connect_to_nearest_attachments).
 
 #include <Eigen/Geometry>
 #include <functional>

@@ -184,9 +184,11 @@ TEST(DecomposeFibresNodeTest, FibresFollowTheWrappedMuscleFrameByFrame) {
     longest = std::max(longest, length);
   }
   // The fibres end on the muscle's own end patches (no tendon), so they
-  // change only as much as the wrapped belly: 0.9 % on this walk, where
-  // fibres copied from rest would not change at all.
-  EXPECT_GT(longest - shortest, 0.005 * longest);
+  // change only as much as the wrapped belly (0.3 % here); fibres copied
+  // from rest would not change at all, nor stay inside every frame's
+  // surface (min_inside_fraction covers the frames).
+  EXPECT_GT(longest - shortest, 0.001 * longest);
+  EXPECT_GE(report["muscles"][0]["frames_min_inside_fraction"].get<double>(), 0.99);
   const std::filesystem::path fibres = harness.folder() / "fibres";
   unpack_directory(mmm::test::read_text(outputs.at("fibres").path), fibres, "fibres");
   EXPECT_EQ(mesh::read_pvd(fibres / "fibres.pvd").size(), static_cast<std::size_t>(frames));

@@ -2,7 +2,8 @@
 // (so a square maps onto itself, and onto any affine image of itself,
 // exactly), are non-negative and sum to one, and interpolate on the
 // boundary; a loop is made consistent: counter-clockwise about the axis,
-// starting on the reference side, at equal arc-length steps.
+// starting on the reference side, at equal arc-length steps; a contour's
+// start moved to match its neighbour recovers a known shift.
 
 #include "core/fibres/contour_map.h"
 
@@ -82,6 +83,37 @@ TEST(ConsistentContour, ClockwiseLoopIsTurnedAndStartsOnTheReferenceSide) {
                InvalidInputError);
   EXPECT_THROW((void)consistent_contour(loop.topRows(2), Vector3d::UnitZ(), Vector3d::UnitX(), 64),
                InvalidInputError);
+}
+
+// An ellipse sampled at `count` equal angle steps from angle `start` (rad),
+// centred on `centre`: its points are not at equal arc length, which does not
+// matter for a pure shift of the start.
+Contour ellipse(int count, double start, const Vector3d& centre) {
+  Contour c(count, 3);
+  for (int i = 0; i < count; ++i) {
+    const double a = start + 2.0 * std::numbers::pi * i / count;
+    c.row(i) = (centre + Vector3d(20.0 * std::cos(a), 8.0 * std::sin(a), 0.0)).transpose();
+  }
+  return c;
+}
+
+TEST(AlignStart, RecoversAWholeAndAFractionalShift) {
+  constexpr int kCount = 64;
+  const double step = 2.0 * std::numbers::pi / kCount;
+  const Contour neighbour = ellipse(kCount, 0.0, Vector3d(0, 0, 0));
+  // The same ellipse 5 mm higher and moved sideways, starting 7 steps later:
+  // its start goes back 7 steps, whatever the offset of the centres.
+  const Contour later = ellipse(kCount, 7.0 * step, Vector3d(3, -2, 5));
+  const Contour aligned = align_start(later, neighbour);
+  EXPECT_LT((aligned.rowwise() - Eigen::RowVector3d(3, -2, 5) - neighbour).rowwise().norm().maxCoeff(),
+            1e-9);
+  // A start 3.4 steps later: moved back to within the chord of one step.
+  const Contour fraction = align_start(ellipse(kCount, 3.4 * step, Vector3d::Zero()), neighbour);
+  EXPECT_LT((fraction - neighbour).rowwise().norm().maxCoeff(), 0.3);
+  EXPECT_LT((fraction.row(0) - neighbour.row(0)).norm(), 0.3);
+  // Already aligned: unchanged, bit for bit.
+  EXPECT_EQ(align_start(neighbour, neighbour), neighbour);
+  EXPECT_THROW((void)align_start(neighbour, ellipse(32, 0.0, Vector3d::Zero())), InvalidInputError);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/fibres/end_patches.h"
 #include "core/fibres/fibre_mapping.h"
 #include "core/fibres/fibre_templates.h"
 #include "core/fibres/harmonic_decomposition.h"
@@ -169,6 +170,66 @@ TEST(SlicingDecomposition, BadInputIsRefused) {
   EXPECT_THROW((void)slicing_fibres(cylinder, same, {}), InvalidInputError);
   EXPECT_THROW((void)harmonic_fibres(cylinder, attachments, Eigen::VectorXd::Zero(3)),
                InvalidInputError);
+}
+
+// The end patches of a cylinder whose end discs are its attachment areas:
+// each disc and the side ring within the margin; an area 10 mm beyond the
+// top (a tendon) gives the gap and the same top patch.
+TEST(EndPatches, AreTheEndCapsWithOrWithoutATendonGap) {
+  const mesh::IndexedMesh cylinder = testing::ringed_cylinder(kRadius, kLength, 48, 40);
+  Attachments areas = testing::cylinder_attachments(kRadius, kLength);
+  const EndPatches touching = end_patches(cylinder, areas, 1.5);
+  EXPECT_LT(touching.insertion_gap_mm, 1e-9);
+  areas.insertion.col(2).array() += 10.0;
+  const EndPatches beyond = end_patches(cylinder, areas, 1.5);
+  EXPECT_NEAR(beyond.insertion_gap_mm, 10.0, 1e-9);  // the cap's centre, straight below
+  EXPECT_EQ(beyond.insertion, touching.insertion);
+  EXPECT_EQ(beyond.origin, touching.origin);
+  for (const int v : beyond.insertion) {
+    EXPECT_NEAR(cylinder.V(v, 2), kLength, 1e-9);
+  }
+  // The attachments the methods take: the patch vertices where the surface is now.
+  Eigen::MatrixX3d moved = cylinder.V;
+  moved.col(0).array() += 4.0;
+  const Attachments at = patch_attachments(beyond, moved, areas);
+  ASSERT_EQ(at.insertion.rows(), static_cast<Eigen::Index>(beyond.insertion.size()));
+  EXPECT_EQ(at.insertion.row(0), moved.row(beyond.insertion.front()));
+  EXPECT_NEAR(patch_gap(beyond.insertion, cylinder.V, areas.insertion), 10.0, 1e-9);
+  EXPECT_THROW((void)end_patches(cylinder, areas, -1.0), InvalidInputError);
+  areas.origin.resize(0, 3);
+  EXPECT_THROW((void)end_patches(cylinder, areas), InvalidInputError);
+}
+
+// Fibres that stop short of the discs are connected to the nearest disc
+// point: on the disc to 1e-9 (the closest surface point of a disc point is
+// itself), straight where the cylinder is straight, none outside.
+TEST(ConnectToNearestAttachments, CarriesShortFibresOntoTheDiscs) {
+  const mesh::IndexedMesh cylinder = testing::ringed_cylinder(kRadius, kLength, 48, 40);
+  const Attachments areas = testing::cylinder_attachments(kRadius, kLength);
+  std::vector<Fibre> fibres;
+  for (const double x : {-4.0, 0.0, 4.0}) {  // at y = 1
+    Fibre f(11, 3);
+    for (int k = 0; k <= 10; ++k) f.row(k) << x, 1.0, 15.0 + 5.0 * k;
+    fibres.push_back(f);
+  }
+  const int moved = connect_to_nearest_attachments(fibres, cylinder, areas, 20, 2);
+  // Only the six ends: on the discs, the winding number calls them outside
+  // and keep_inside puts them back onto the surface (where they are).
+  EXPECT_EQ(moved, 6);
+  const std::vector<double> xs = {-4.0, 0.0, 4.0};
+  for (std::size_t i = 0; i < fibres.size(); ++i) {
+    const Fibre& f = fibres[i];
+    ASSERT_EQ(f.rows(), 21);
+    EXPECT_NEAR(f(0, 2), 0.0, 1e-9);
+    EXPECT_NEAR(f(20, 2), kLength, 1e-9);
+    // The nearest disc point of (x, 1) is within the disc grid's spacing of it.
+    const Eigen::Vector2d own(xs[i], 1.0);
+    EXPECT_LT((f.row(0).head<2>().transpose() - own).norm(), 2.0);
+    EXPECT_LT((f.row(20).head<2>().transpose() - own).norm(), 2.0);
+    // The middle stays where it was.
+    EXPECT_LT((f.row(10).head<2>().transpose() - own).norm(), 0.1);
+  }
+  EXPECT_EQ(points_outside(cylinder, fibres, 1e-6), 0);
 }
 
 }  // namespace
