@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
 
 #include "core/errors.h"
@@ -49,16 +50,30 @@ std::vector<Fibre> fibres_through_contours(const std::vector<Contour>& contours,
 
 namespace {
 
-// Coordinates in the cross-section plane, stretched over [0, 1]^2.
-Eigen::MatrixX2d unit_layout(const Eigen::MatrixX2d& plane) {
-  const Eigen::RowVector2d lo = plane.colwise().minCoeff();
-  const Eigen::RowVector2d span = (plane.colwise().maxCoeff() - lo).cwiseMax(1e-12);
-  return (plane.rowwise() - lo).array().rowwise() / span.array();
+// Each coordinate replaced by its rank among the points' (ties in order of
+// index) over count - 1: [0, 1], evenly spread whatever the clustering.
+Eigen::MatrixX2d quantile_layout(const Eigen::MatrixX2d& plane) {
+  const Index n = plane.rows();
+  Eigen::MatrixX2d out = Eigen::MatrixX2d::Constant(n, 2, 0.5);
+  if (n < 2) {
+    return out;
+  }
+  std::vector<Index> order(static_cast<std::size_t>(n));
+  for (int c = 0; c < 2; ++c) {
+    std::iota(order.begin(), order.end(), Index{0});
+    std::stable_sort(order.begin(), order.end(),
+                     [&](Index a, Index b) { return plane(a, c) < plane(b, c); });
+    for (Index r = 0; r < n; ++r) {
+      out(order[static_cast<std::size_t>(r)], c) = static_cast<double>(r) / static_cast<double>(n - 1);
+    }
+  }
+  return out;
 }
 
 }  // namespace
 
-std::vector<int> match_ends(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& ends) {
+std::vector<int> match_ends(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& ends,
+                            const MuscleAxes& axes, EndLayout layout) {
   if (points.rows() == 0) {
     throw InvalidInputError("match_ends: the attachment area has no points");
   }
@@ -66,13 +81,18 @@ std::vector<int> match_ends(const Eigen::MatrixX3d& points, const Eigen::MatrixX
   if (ends.rows() == 0) {
     return chosen;
   }
-  // The area's principal plane: its two directions of largest spread.
   const Eigen::RowVector3d centre = points.colwise().mean();
   const Eigen::MatrixX3d centred = points.rowwise() - centre;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(centred.transpose() * centred);
-  const Eigen::Matrix<double, 3, 2> plane = solver.eigenvectors().rightCols<2>();
-  const Eigen::MatrixX2d area = unit_layout(centred * plane);
-  const Eigen::MatrixX2d wanted = unit_layout((ends.rowwise() - centre) * plane);
+  Eigen::Matrix<double, 3, 2> plane;
+  if (layout == EndLayout::kCrossSection) {
+    plane.col(0) = axes.reference;
+    plane.col(1) = axes.axis.cross(axes.reference);
+  } else {  // the area's two directions of largest spread
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(centred.transpose() * centred);
+    plane = solver.eigenvectors().rightCols<2>();
+  }
+  const Eigen::MatrixX2d area = quantile_layout(centred * plane);
+  const Eigen::MatrixX2d wanted = quantile_layout((ends.rowwise() - centre) * plane);
   for (Index i = 0; i < wanted.rows(); ++i) {
     Index best = 0;
     (area.rowwise() - wanted.row(i)).rowwise().squaredNorm().minCoeff(&best);
@@ -145,16 +165,16 @@ ContourFibres contour_sections(const mesh::IndexedMesh& surface, const Eigen::Ve
 }
 
 void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
-                   const std::vector<Fibre>& mapped,
-                   const Attachments& attachments, const DecompositionOptions& options) {
+                   const std::vector<Fibre>& mapped, const Attachments& attachments,
+                   const DecompositionOptions& options, EndLayout layout) {
   Eigen::MatrixX3d starts(static_cast<Index>(mapped.size()), 3);
   Eigen::MatrixX3d ends(static_cast<Index>(mapped.size()), 3);
   for (std::size_t f = 0; f < mapped.size(); ++f) {
     starts.row(static_cast<Index>(f)) = mapped[f].row(0);
     ends.row(static_cast<Index>(f)) = mapped[f].row(mapped[f].rows() - 1);
   }
-  const std::vector<int> origin_of = match_ends(attachments.origin, starts);
-  const std::vector<int> insertion_of = match_ends(attachments.insertion, ends);
+  const std::vector<int> origin_of = match_ends(attachments.origin, starts, result.axes, layout);
+  const std::vector<int> insertion_of = match_ends(attachments.insertion, ends, result.axes, layout);
   const mesh::AabbTree tree(surface);
   const mesh::WindingNumber inside(tree);
   result.fibres.clear();

@@ -19,13 +19,23 @@ namespace mmm::fibres {
 std::vector<Fibre> fibres_through_contours(const std::vector<Contour>& contours,
                                            const std::vector<TemplateFibre>& templates);
 
+// The plane in which fibre ends and attachment points are laid out to be
+// matched: the muscle's cross-section (across axes.axis), for fibres that
+// reach their ends through planar sections across the muscle (slicing,
+// mass-spring); or the attachment area's own principal plane (its two
+// directions of largest spread), for fibres that reach it through contours
+// that hug the area (harmonic level sets).
+enum class EndLayout { kCrossSection, kAttachmentPlane };
+
 // Where each fibre end goes on an attachment area: `points` (the area's
 // samples) and `ends` (#fibres by 3, where the fibres end before they are
-// extended) are both laid out in the area's principal plane (its two
-// directions of largest spread), each stretched over [0, 1]^2 by its
-// bounding box; each end gets the index of the nearest point. So fibres keep
-// their arrangement and their ends spread over the whole area.
-std::vector<int> match_ends(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& ends);
+// extended) are both laid out in the plane `layout`, and each coordinate is
+// replaced by its rank over the count - 1 (so both spread evenly over
+// [0, 1]^2 however they cluster); each end gets the index of the nearest
+// point. So fibres keep their arrangement and their ends spread over the
+// whole area.
+std::vector<int> match_ends(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& ends,
+                            const MuscleAxes& axes, EndLayout layout);
 
 // The fibre with an extension at each end: a quadratic Bezier from the
 // target to the fibre's end point, arriving along the fibre's own end
@@ -40,14 +50,14 @@ ContourFibres contour_sections(const mesh::IndexedMesh& surface, const Eigen::Ve
                                int contour_points);
 
 // result.fibres from the fibres `mapped` through result.contours: each end extended to the surface point nearest its own
-// attachment point (match_ends on the mapped fibres' end points), smoothed
+// attachment point (match_ends on the mapped fibres' end points, in `layout`), smoothed
 // (options.smoothing_passes), resampled to options.segments and kept inside
 // `surface` (keep_inside.h, margin kInsideMarginMm; counted in
 // result.moved_inside).
 constexpr double kInsideMarginMm = 0.5;
 void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
-                   const std::vector<Fibre>& mapped,
-                   const Attachments& attachments, const DecompositionOptions& options);
+                   const std::vector<Fibre>& mapped, const Attachments& attachments,
+                   const DecompositionOptions& options, EndLayout layout);
 
 // Each fibre connected at both ends to the nearest of the attachment points
 // (the cadaver method's "connected to their nearest tendons"): extended

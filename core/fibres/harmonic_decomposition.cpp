@@ -25,7 +25,7 @@ HarmonicResult harmonic_fibres(const mesh::IndexedMesh& surface, const Attachmen
   const std::vector<TemplateFibre> templates =
       fibre_template(options.architecture, options.fibres, attachments.narrow_at_insertion());
   finish_fibres(result, surface, fibres_through_contours(result.contours, templates),
-                attachments, options);
+                attachments, options, EndLayout::kAttachmentPlane);
   return result;
 }
 

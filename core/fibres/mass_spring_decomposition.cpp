@@ -27,7 +27,7 @@ MassSpringDecomposition mass_spring_decomposition(const mesh::IndexedMesh& surfa
   const MassSpringResult balanced = mass_spring_fibres(result.contours, spring);
   result.iterations = balanced.iterations;
   result.converged = balanced.converged;
-  finish_fibres(result, surface, balanced.fibres, attachments, options);
+  finish_fibres(result, surface, balanced.fibres, attachments, options, EndLayout::kCrossSection);
   return result;
 }
 

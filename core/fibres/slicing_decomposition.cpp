@@ -41,7 +41,7 @@ SlicingResult slicing_fibres(const mesh::IndexedMesh& surface, const Attachments
   const std::vector<TemplateFibre> templates =
       fibre_template(options.architecture, options.fibres, attachments.narrow_at_insertion());
   finish_fibres(result, surface, fibres_through_contours(result.contours, templates),
-                attachments, options);
+                attachments, options, EndLayout::kCrossSection);
   return result;
 }
 
