@@ -117,9 +117,9 @@ nlohmann::json quality_table(std::ostringstream& out) {
          "area (mm); moved: points moved inside\n";
   out << std::left << std::setw(30) << "muscle" << std::setw(12) << "method" << std::right
       << std::setw(8) << "inside%" << std::setw(12) << "ends o/i" << std::setw(13) << "cover o/i"
-      << std::setw(14) << "tendon o/i" << std::setw(14) << "to bone o/i" << std::setw(9) << "spac.cv" << std::setw(9) << "len mm"
-      << std::setw(8) << "len.cv" << std::setw(8) << "fit mm" << std::setw(7) << "moved"
-      << std::setw(8) << "ms"
+      << std::setw(14) << "tendon o/i" << std::setw(14) << "to bone o/i" << std::setw(9)
+      << "spac.cv" << std::setw(9) << "len mm" << std::setw(8) << "len.cv" << std::setw(8)
+      << "fit mm" << std::setw(7) << "moved" << std::setw(8) << "ms"
       << "\n";
   nlohmann::json rows = nlohmann::json::array();
   std::map<DecompositionMethod, std::vector<double>> inside;
@@ -147,10 +147,10 @@ nlohmann::json quality_table(std::ostringstream& out) {
               fixed(q.insertion_end_distance_median_mm, 1))
           << std::setw(13) << (fixed(q.origin_coverage, 2) + " / " + fixed(q.insertion_coverage, 2))
           << std::setw(14) << (fixed(gap_o, 1) + " / " + fixed(gap_i, 1)) << std::setw(14)
-          << (fixed(bone_o, 1) + " / " + fixed(bone_i, 1)) << std::setw(9)
-          << fixed(q.spacing_cv, 2) << std::setw(9) << fixed(q.length_median_mm, 0) << std::setw(8)
-          << fixed(q.length_cv, 2) << std::setw(8) << fixed(q.fit_error_mean_mm, 2) << std::setw(7)
-          << result.moved_inside << std::setw(8) << fixed(1000.0 * result.seconds, 1)
+          << (fixed(bone_o, 1) + " / " + fixed(bone_i, 1)) << std::setw(9) << fixed(q.spacing_cv, 2)
+          << std::setw(9) << fixed(q.length_median_mm, 0) << std::setw(8) << fixed(q.length_cv, 2)
+          << std::setw(8) << fixed(q.fit_error_mean_mm, 2) << std::setw(7) << result.moved_inside
+          << std::setw(8) << fixed(1000.0 * result.seconds, 1)
           << (result.stand_in_measured ? "  (stand-in measured fibres)" : "") << "\n";
       nlohmann::json row = q;
       row["muscle"] = muscle.name;
@@ -173,9 +173,9 @@ nlohmann::json quality_table(std::ostringstream& out) {
     const auto& c = cover[method];
     out << "  " << std::left << std::setw(12) << fibres::method_name(method) << std::right
         << fixed(100.0 * *std::min_element(inside[method].begin(), inside[method].end()), 2)
-        << " %   ends " << fixed(median(e), 2) << " / " << fixed(*std::max_element(e.begin(), e.end()), 2)
-        << " mm   cover " << fixed(median(c), 2) << " / "
-        << fixed(*std::min_element(c.begin(), c.end()), 2) << "\n";
+        << " %   ends " << fixed(median(e), 2) << " / "
+        << fixed(*std::max_element(e.begin(), e.end()), 2) << " mm   cover " << fixed(median(c), 2)
+        << " / " << fixed(*std::min_element(c.begin(), c.end()), 2) << "\n";
   }
   return rows;
 }

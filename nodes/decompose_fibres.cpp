@@ -174,7 +174,9 @@ workflow::NodeSpec DecomposeFibres::spec() {
       .output<File>("fibres", "Folder bundle: fibres.pvd + .vtp polylines per muscle and frame")
       .output<File>("lengths", "CSV: muscle, method, fibre, frame, time (s), length (mm)")
       .output<File>("picture", "PNG: a muscle with its fibres, front and side")
-      .output<Report>("report", "Per muscle: method, quality at rest, worst inside fraction over the frames, tendon gaps, times");
+      .output<Report>("report",
+                      "Per muscle: method, quality at rest, worst inside fraction over the frames, "
+                      "tendon gaps, times");
 }
 
 void DecomposeFibres::run(workflow::NodeContext& context) {
@@ -262,11 +264,11 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
         const fibres::MuscleFibres result = model.decompose(
             wrapped.V, [&](const std::string& bone) { return poses.pose(bone, k, frame); });
         frame_seconds += result.seconds;
-        frames_inside = std::min(
-            frames_inside, fibres::measure_fibre_quality(wrapped, result.fibres,
-                                                         result.attachments.origin,
-                                                         result.attachments.insertion)
-                               .inside_fraction);
+        frames_inside =
+            std::min(frames_inside, fibres::measure_fibre_quality(wrapped, result.fibres,
+                                                                  result.attachments.origin,
+                                                                  result.attachments.insertion)
+                                        .inside_fraction);
         add_frame(result, static_cast<int>(k), frame.time);
       }
     }

@@ -21,8 +21,8 @@ struct ContourStack {
 // The closed loop nearest the middle level starts on the side of
 // `reference`; from it outward, each loop starts where it best matches its
 // neighbour (contour_map.h, align_start), so starts do not jump between
-// sides where tilted or non-planar loops see the reference differently. Throws InvalidInputError when fewer
-// than two levels have a closed loop.
+// sides where tilted or non-planar loops see the reference differently. Throws InvalidInputError
+// when fewer than two levels have a closed loop.
 ContourStack contour_stack(const mesh::IndexedMesh& surface, const Eigen::VectorXd& values,
                            const std::vector<double>& levels, const Eigen::Vector3d& reference,
                            int contour_points);

@@ -64,7 +64,8 @@ EndPatches end_patches(const mesh::IndexedMesh& surface, const Attachments& area
                             " mm; use a finite margin >= 0 (3 mm)");
   }
   if (surface.V.rows() < 2 * kMinimumVertices || !surface.V.allFinite()) {
-    throw InvalidInputError("end patches: the surface has fewer than 6 vertices or a non-finite one");
+    throw InvalidInputError(
+        "end patches: the surface has fewer than 6 vertices or a non-finite one");
   }
   const Eigen::VectorXd to_origin = distances(surface.V, areas.origin);
   const Eigen::VectorXd to_insertion = distances(surface.V, areas.insertion);
@@ -110,8 +111,8 @@ double patch_gap(const std::vector<int>& patch, const Eigen::MatrixX3d& position
                  const Eigen::MatrixX3d& points) {
   double gap = std::numeric_limits<double>::infinity();
   for (const int v : patch) {
-    gap = std::min(gap,
-                   std::sqrt((points.rowwise() - positions.row(v)).rowwise().squaredNorm().minCoeff()));
+    gap = std::min(
+        gap, std::sqrt((points.rowwise() - positions.row(v)).rowwise().squaredNorm().minCoeff()));
   }
   return gap;
 }

@@ -64,7 +64,8 @@ Eigen::MatrixX2d quantile_layout(const Eigen::MatrixX2d& plane) {
     std::stable_sort(order.begin(), order.end(),
                      [&](Index a, Index b) { return plane(a, c) < plane(b, c); });
     for (Index r = 0; r < n; ++r) {
-      out(order[static_cast<std::size_t>(r)], c) = static_cast<double>(r) / static_cast<double>(n - 1);
+      out(order[static_cast<std::size_t>(r)], c) =
+          static_cast<double>(r) / static_cast<double>(n - 1);
     }
   }
   return out;
@@ -174,7 +175,8 @@ void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
     ends.row(static_cast<Index>(f)) = mapped[f].row(mapped[f].rows() - 1);
   }
   const std::vector<int> origin_of = match_ends(attachments.origin, starts, result.axes, layout);
-  const std::vector<int> insertion_of = match_ends(attachments.insertion, ends, result.axes, layout);
+  const std::vector<int> insertion_of =
+      match_ends(attachments.insertion, ends, result.axes, layout);
   const mesh::AabbTree tree(surface);
   const mesh::WindingNumber inside(tree);
   result.fibres.clear();

@@ -49,9 +49,9 @@ ContourFibres contour_sections(const mesh::IndexedMesh& surface, const Eigen::Ve
                                const std::vector<double>& levels, const MuscleAxes& axes,
                                int contour_points);
 
-// result.fibres from the fibres `mapped` through result.contours: each end extended to the surface point nearest its own
-// attachment point (match_ends on the mapped fibres' end points, in `layout`), smoothed
-// (options.smoothing_passes), resampled to options.segments and kept inside
+// result.fibres from the fibres `mapped` through result.contours: each end extended to the surface
+// point nearest its own attachment point (match_ends on the mapped fibres' end points, in
+// `layout`), smoothed (options.smoothing_passes), resampled to options.segments and kept inside
 // `surface` (keep_inside.h, margin kInsideMarginMm; counted in
 // result.moved_inside).
 constexpr double kInsideMarginMm = 0.5;

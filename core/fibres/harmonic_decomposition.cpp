@@ -24,8 +24,8 @@ HarmonicResult harmonic_fibres(const mesh::IndexedMesh& surface, const Attachmen
       surface, field, levels, muscle_axes(surface, attachments), options.contour_points);
   const std::vector<TemplateFibre> templates =
       fibre_template(options.architecture, options.fibres, attachments.narrow_at_insertion());
-  finish_fibres(result, surface, fibres_through_contours(result.contours, templates),
-                attachments, options, EndLayout::kAttachmentPlane);
+  finish_fibres(result, surface, fibres_through_contours(result.contours, templates), attachments,
+                options, EndLayout::kAttachmentPlane);
   return result;
 }
 

@@ -10,8 +10,7 @@ namespace mmm::fibres {
 
 using Eigen::Index;
 
-Eigen::VectorXd harmonic_field(const mesh::IndexedMesh& surface,
-                               const EndPatches& ends) {
+Eigen::VectorXd harmonic_field(const mesh::IndexedMesh& surface, const EndPatches& ends) {
   const Index n = surface.V.rows();
   if (ends.origin.empty() || ends.insertion.empty()) {
     throw InvalidInputError(

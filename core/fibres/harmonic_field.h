@@ -21,7 +21,6 @@ namespace mmm::fibres {
 // (end_patches.h). Throws InvalidInputError for an empty
 // attachment set or overlapping ones, SolverError when the system cannot be
 // factored (a piece of the surface touching neither attachment).
-Eigen::VectorXd harmonic_field(const mesh::IndexedMesh& surface,
-                               const EndPatches& ends);
+Eigen::VectorXd harmonic_field(const mesh::IndexedMesh& surface, const EndPatches& ends);
 
 }  // namespace mmm::fibres

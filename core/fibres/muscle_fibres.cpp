@@ -6,8 +6,8 @@
 
 #include "core/errors.h"
 #include "core/fibres/cadaver_fibres.h"
-#include "core/fibres/harmonic_decomposition.h"
 #include "core/fibres/fibre_mapping.h"
+#include "core/fibres/harmonic_decomposition.h"
 #include "core/fibres/harmonic_field.h"
 #include "core/fibres/mass_spring_decomposition.h"
 #include "core/fibres/slicing_decomposition.h"

@@ -49,7 +49,7 @@ struct MuscleFibres {
   Attachments bone_areas;
   double origin_gap_mm = 0.0;
   double insertion_gap_mm = 0.0;
-  int moved_inside = 0;     // fibre points moved into the muscle
+  int moved_inside = 0;  // fibre points moved into the muscle
   int interpolated_contours = 0;
   bool stand_in_measured = false;  // cadaver: measured fibres were stand-ins
   double seconds = 0.0;            // this decomposition (the precomputed field not included)

@@ -105,8 +105,9 @@ TEST(AlignStart, RecoversAWholeAndAFractionalShift) {
   // its start goes back 7 steps, whatever the offset of the centres.
   const Contour later = ellipse(kCount, 7.0 * step, Vector3d(3, -2, 5));
   const Contour aligned = align_start(later, neighbour);
-  EXPECT_LT((aligned.rowwise() - Eigen::RowVector3d(3, -2, 5) - neighbour).rowwise().norm().maxCoeff(),
-            1e-9);
+  EXPECT_LT(
+      (aligned.rowwise() - Eigen::RowVector3d(3, -2, 5) - neighbour).rowwise().norm().maxCoeff(),
+      1e-9);
   // A start 3.4 steps later: moved back to within the chord of one step.
   const Contour fraction = align_start(ellipse(kCount, 3.4 * step, Vector3d::Zero()), neighbour);
   EXPECT_LT((fraction - neighbour).rowwise().norm().maxCoeff(), 0.3);

@@ -125,8 +125,7 @@ TEST(SlicingDecomposition, ParallelFibresOfACylinder) {
 TEST(HarmonicDecomposition, ParallelFibresOfACylinder) {
   const mesh::IndexedMesh cylinder = testing::ringed_cylinder(kRadius, kLength, 48, 40);
   const Attachments attachments = testing::cylinder_attachments(kRadius, kLength);
-  const Eigen::VectorXd field =
-      harmonic_field(cylinder, end_patches(cylinder, attachments));
+  const Eigen::VectorXd field = harmonic_field(cylinder, end_patches(cylinder, attachments));
   const HarmonicResult result = harmonic_fibres(cylinder, attachments, field);
   EXPECT_EQ(result.interpolated_contours, 0);
   // The level sets are the cylinder's cross-sections.
