@@ -1,5 +1,9 @@
 // mmm patient synth: synthetic patients (ground truth + biplanar radiographs).
+// mmm patient clicks: a scripted operator's landmark clicks on them (demos
+// and tests only).
 
+#include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -9,6 +13,8 @@
 
 #include "app/commands/commands.h"
 #include "core/atlas/synthetic_patient.h"
+#include "core/errors.h"
+#include "core/landmarks/scripted_clicks.h"
 
 namespace mmm::app {
 namespace {
@@ -61,6 +67,37 @@ void run_synth(const SynthArgs& args) {
             << "{frontal,lateral}.png + views.json\n";
 }
 
+struct ClickArgs {
+  std::string patient;
+  std::string out;
+  landmarks::ScriptedClickOptions options;
+};
+
+void run_clicks(const ClickArgs& args) {
+  const std::filesystem::path truth_file = std::filesystem::path(args.patient) / "ground_truth.json";
+  std::ifstream in(truth_file);
+  if (!in) {
+    throw InvalidInputError(truth_file.string() +
+                            ": cannot be read; give the folder that mmm patient synth wrote");
+  }
+  nlohmann::json truth;
+  try {
+    truth = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& error) {
+    throw InvalidInputError(truth_file.string() + ": not JSON (" + error.what() + ")");
+  }
+  const nlohmann::json clicks = landmarks::scripted_clicks(truth, args.options);
+  std::ofstream out(args.out);
+  out << clicks.dump(2) << '\n';
+  if (!out) {
+    throw InvalidInputError(args.out + ": cannot be written");
+  }
+  std::cerr << "scripted operator (not a person): " << args.options.landmarks.size()
+            << " landmarks from " << truth_file.string() << " + Gaussian click noise of "
+            << args.options.noise_px << " px (seed " << args.options.seed << ") -> " << args.out
+            << '\n';
+}
+
 }  // namespace
 
 void register_patient_commands(CLI::App& app) {
@@ -82,6 +119,24 @@ void register_patient_commands(CLI::App& app) {
       ->check(CLI::Range(0.05, 2.0));
   synth->add_flag("--json", args->json, "Print the drawn factors as JSON");
   synth->callback([args] { run_synth(*args); });
+
+  auto clicks = std::make_shared<ClickArgs>();
+  auto* click = patient->add_subcommand(
+      "clicks",
+      "A scripted operator, for demos and tests only: landmark clicks from a synthetic "
+      "patient's ground truth with Gaussian noise, as a submission for 'mmm task submit --file'");
+  click->add_option("patient", clicks->patient, "Patient folder (from mmm patient synth)")
+      ->required();
+  click->add_option("-o,--out", clicks->out, "Submission JSON to write")->required();
+  click->add_option("--noise-px", clicks->options.noise_px,
+                    "Standard deviation of each click coordinate (pixels)")
+      ->check(CLI::Range(0.0, 50.0));
+  click->add_option("--seed", clicks->options.seed, "Random seed of the noise");
+  click
+      ->add_option("--landmarks", clicks->options.landmarks,
+                   "Landmarks to click (default: femoral head, patella and ankle centres)")
+      ->delimiter(',');
+  click->callback([clicks] { run_clicks(*clicks); });
 }
 
 }  // namespace mmm::app

@@ -63,7 +63,7 @@ EndPatches end_patches(const mesh::IndexedMesh& surface, const Attachments& area
     throw InvalidInputError("end patches: margin " + std::to_string(margin_mm) +
                             " mm; use a finite margin >= 0 (3 mm)");
   }
-  if (surface.V.rows() < 2 * kMinimumVertices || !surface.V.allFinite()) {
+  if (surface.V.rows() < Index{2} * kMinimumVertices || !surface.V.allFinite()) {
     throw InvalidInputError(
         "end patches: the surface has fewer than 6 vertices or a non-finite one");
   }
