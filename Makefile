@@ -1,5 +1,5 @@
 # mmm: the two commands of the README, and the helpers behind them.
-#   make demo   install what is missing, build (Release), run the main job
+#   make demo   install what is missing, build (Release), run the default study end to end
 #   make test   install what is missing, build (Release), run the whole test suite
 # Other targets: build, deps, bench [SUITE=mesh], format, lint, clean.
 
@@ -26,32 +26,16 @@ LINT_PACKAGES := clang-format clang-tidy
 
 .PHONY: demo test build deps deps-lint configure bench format lint clean
 
-# The most complete real job that exists today: the default atlas (built when
-# missing or when its recipe changed), checked and pictured; a synthetic
-# patient with its calibrated radiograph pair; a survey of every real surface;
-# a study of the example workflow (created once; later runs reuse it).
+# The default study end to end (cmake/demo.sh): the default atlas (built when
+# missing or when its recipe changed), synthetic patient 1 with its calibrated
+# radiograph pair, a study of workflows/default.yaml run to the landmark
+# station, a clearly labelled scripted operator placing the landmarks (noisy
+# clicks from the patient's ground truth), then scaling, motion, wrapping and
+# fibres. MANUAL=1 leaves the landmark task open for a person instead.
+# Interrupt it at any point and run it again: it goes on where it stopped.
+MANUAL ?= 0
 demo: build $(ATLAS_DIR)/atlas.yaml
-	@echo "== mmm demo: check of the default atlas ($(ATLAS_DIR)) =="
-	$(BUILD_DIR)/bin/mmm atlas check $(ATLAS_DIR)
-	@mkdir -p $(BUILD_DIR)/demo
-	$(BUILD_DIR)/bin/mmm atlas show $(ATLAS_DIR) --png $(BUILD_DIR)/demo/atlas.png
-	@echo "== mmm demo: synthetic patient 1 and its frontal/lateral radiographs =="
-	@test -f $(BUILD_DIR)/demo/patient_1/ground_truth.json || \
-	  $(BUILD_DIR)/bin/mmm patient synth --atlas $(ATLAS_DIR) --seed 1 -o $(BUILD_DIR)/demo/patient_1
-	@echo "== mmm demo: survey of the Visible Human Female surfaces =="
-	$(BUILD_DIR)/bin/mmm mesh survey $(DATA_DIR)/vhf --out $(BUILD_DIR)/demo/vhf --lod-faces 2000
-	@echo "== mmm demo: survey of the OpenSim gait2392 bones (m -> mm) =="
-	$(BUILD_DIR)/bin/mmm mesh survey $(DATA_DIR)/gait2392/Geometry --scale 1000 \
-	  --out $(BUILD_DIR)/demo/gait2392
-	@echo "== mmm demo: a study (schemas/examples/mesh_demo.yaml) on the VHF gluteus medius =="
-	@test -d $(BUILD_DIR)/demo/study || $(BUILD_DIR)/bin/mmm study create $(BUILD_DIR)/demo/study \
-	  --workflow schemas/examples/mesh_demo.yaml \
-	  --input surface=$(DATA_DIR)/vhf/Right/VHF_Right_Muscle_GluteusMedius_smooth.stl
-	$(BUILD_DIR)/bin/mmm run $(BUILD_DIR)/demo/study -j $(JOBS)
-	$(BUILD_DIR)/bin/mmm status $(BUILD_DIR)/demo/study
-	@echo "Atlas: $(ATLAS_DIR) (picture: $(BUILD_DIR)/demo/atlas.png); patient: $(BUILD_DIR)/demo/patient_1"
-	@echo "  (radiographs/pair_preview.png, ground_truth.json); open $(BUILD_DIR)/demo/*/vtp/*.vtp"
-	@echo "and $(BUILD_DIR)/demo/study/outputs/*.ply in ParaView; figures in $(BUILD_DIR)/demo/*/survey.csv"
+	./cmake/demo.sh $(BUILD_DIR)/bin/mmm $(ATLAS_DIR) $(DATA_DIR) $(BUILD_DIR)/demo $(JOBS) $(MANUAL)
 
 # The default atlas: rebuilt when missing or when its recipe changes.
 $(ATLAS_DIR)/atlas.yaml: $(RECIPE) | build
