@@ -74,7 +74,8 @@ struct ClickArgs {
 };
 
 void run_clicks(const ClickArgs& args) {
-  const std::filesystem::path truth_file = std::filesystem::path(args.patient) / "ground_truth.json";
+  const std::filesystem::path truth_file =
+      std::filesystem::path(args.patient) / "ground_truth.json";
   std::ifstream in(truth_file);
   if (!in) {
     throw InvalidInputError(truth_file.string() +
@@ -128,8 +129,9 @@ void register_patient_commands(CLI::App& app) {
   click->add_option("patient", clicks->patient, "Patient folder (from mmm patient synth)")
       ->required();
   click->add_option("-o,--out", clicks->out, "Submission JSON to write")->required();
-  click->add_option("--noise-px", clicks->options.noise_px,
-                    "Standard deviation of each click coordinate (pixels)")
+  click
+      ->add_option("--noise-px", clicks->options.noise_px,
+                   "Standard deviation of each click coordinate (pixels)")
       ->check(CLI::Range(0.0, 50.0));
   click->add_option("--seed", clicks->options.seed, "Random seed of the noise");
   click

@@ -29,16 +29,21 @@ nlohmann::json scripted_clicks(const nlohmann::json& ground_truth,
                               name + "'");
     }
     for (const auto& [view, pixel] : (*landmark)["pixels"].items()) {
+      const auto where = [&name, &view = view] {
+        std::string text = "scripted clicks: landmark '";
+        text += name;
+        text += "', view '";
+        text += view;
+        return text + "': ";
+      };
       if (!pixel.is_array() || pixel.size() != 2 || !pixel[0].is_number() ||
           !pixel[1].is_number()) {
-        throw InvalidInputError("scripted clicks: landmark '" + name + "', view '" + view +
-                                "': the pixel is not [u, v]");
+        throw InvalidInputError(where() + "the pixel is not [u, v]");
       }
       const double u = pixel[0].get<double>() + options.noise_px * noise(random);
       const double v = pixel[1].get<double>() + options.noise_px * noise(random);
       if (!std::isfinite(u) || !std::isfinite(v)) {
-        throw InvalidInputError("scripted clicks: landmark '" + name + "', view '" + view +
-                                "': the pixel is not finite");
+        throw InvalidInputError(where() + "the pixel is not finite");
       }
       clicks[name][view] = {u, v};
     }

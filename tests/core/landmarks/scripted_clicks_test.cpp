@@ -46,8 +46,8 @@ TEST(ScriptedClicks, NoiseHasTheAskedSpreadAndIsRepeatable) {
     for (const auto& [name, views] : clicks["landmarks"].items()) {
       for (const auto& [view, pixel] : views.items()) {
         for (int c = 0; c < 2; ++c) {
-          const double d = pixel[c].get<double>() -
-                           truth()["landmarks"][name]["pixels"][view][c].get<double>();
+          const double d =
+              pixel[c].get<double>() - truth()["landmarks"][name]["pixels"][view][c].get<double>();
           sum += d;
           squares += d * d;
           ++count;
