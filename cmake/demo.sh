@@ -72,8 +72,11 @@ EOT
 fi
 
 "$mmm" status "$study"
+stage "the study report"
+"$mmm" report "$study"
 cat <<EOT
 == mmm demo: done ==
+  Report:   $study/report/index.html  (open it in a browser; it needs no network)
   Study:    $study  (mmm status / mmm explain / mmm audit show)
   Outputs:  $study/outputs/ -- patient_atlas/, overlay.png (scaled bones on the radiographs),
             angle_plot.svg, wrapping_plot.svg, fibre_picture.png, *.csv;

@@ -32,6 +32,9 @@ void register_study_commands(CLI::App& app, const workflow::NodeRegistry& regist
 // mmm audit verify|show, mmm operator add|list
 void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registry);
 
+// mmm report: the study report for people (index.html)
+void register_report_commands(CLI::App& app, const workflow::NodeRegistry& registry);
+
 // mmm serve: the operator web UI (the registry must outlive the server)
 void register_serve_commands(CLI::App& app, const workflow::NodeRegistry& registry);
 

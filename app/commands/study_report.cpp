@@ -156,8 +156,7 @@ struct StatusArgs {
 
 void run_status(const StatusArgs& args, const workflow::NodeRegistry& registry) {
   workflow::Study study = workflow::Study::open(args.dir, registry);
-  const StudyPlan plan = current_plan(study);
-  const nlohmann::json json = status_json(study, plan);
+  const nlohmann::json json = study_status(study);
   if (args.json) {
     std::cout << json.dump(2) << '\n';
   } else {
@@ -240,6 +239,10 @@ void run_explain(const ExplainArgs& args, const workflow::NodeRegistry& registry
 }
 
 }  // namespace
+
+nlohmann::json study_status(workflow::Study& study) {
+  return status_json(study, current_plan(study));
+}
 
 void register_study_report_commands(CLI::App& app, const workflow::NodeRegistry& registry) {
   auto status_args = std::make_shared<StatusArgs>();

@@ -121,5 +121,33 @@ TEST_F(StationCliTest, PauseSubmitRejectedThenAcceptedResumesAndTheAuditVerifies
   EXPECT_NE(tampered.err.find("entry 2"), std::string::npos) << tampered.err;
 }
 
+// mmm report on a study that has only its landmarks: the audit section names
+// who submitted which landmarks, the later sections say they are not computed
+// yet, and the page is offline (no scripts, no links out).
+TEST_F(StationCliTest, ReportShowsTheAuditAndWhatIsNotComputedYet) {
+  EXPECT_EQ(run_mmm("run " + study_.string() + " -q").exit_code, 3);
+  const std::string id = task_id();
+  const std::string task = " --root " + root_.string();
+  ASSERT_EQ(run_mmm("task claim " + id + task + " --operator ana").exit_code, 0);
+  const CommandResult accepted = run_mmm("task submit " + id + task + " --operator ana" +
+                                         point("femoral_head_centre_r", {90, 0, 900}) +
+                                         point("patella_centre_r", {80, 30, 480}));
+  ASSERT_EQ(accepted.exit_code, 0) << accepted.err;
+
+  const CommandResult reported = run_mmm("report " + study_.string());
+  ASSERT_EQ(reported.exit_code, 0) << reported.err;
+  EXPECT_NE(reported.out.find("not computed yet: overlay scaling motion wrapping fibres"),
+            std::string::npos)
+      << reported.out;
+  const std::string html = test::read_text(study_ / "report/index.html");
+  EXPECT_NE(html.find("<td>ana</td><td>submit</td>"), std::string::npos);
+  EXPECT_NE(html.find("femoral_head_centre_r, patella_centre_r"), std::string::npos);
+  EXPECT_NE(html.find("id=\"provenance\""), std::string::npos);
+  EXPECT_NE(html.find("<td>landmark_station</td>"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("http"), std::string::npos);
+  EXPECT_EQ(run_mmm("report " + (dir_ / "nothing").string()).exit_code, 1);
+}
+
 }  // namespace
 }  // namespace mmm

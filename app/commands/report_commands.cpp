@@ -1,0 +1,54 @@
+// mmm report: the study report for people (app/report/study_report_page.h).
+
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "app/commands/commands.h"
+#include "app/commands/study_report.h"
+#include "app/report/study_report_page.h"
+#include "workflow/study/study.h"
+#include "worklists/audit_export.h"
+#include "worklists/audit_trail.h"
+
+namespace mmm::app {
+namespace {
+
+struct ReportArgs {
+  std::string dir;
+  std::string out;
+};
+
+void run_report(const ReportArgs& args, const workflow::NodeRegistry& registry) {
+  workflow::Study study = workflow::Study::open(args.dir, registry);
+  worklists::prepare_audit_tables(study.database());
+  report::ReportInput input{study_status(study),
+                            worklists::audit_to_json(worklists::read_audit(study.database())),
+                            study.dir() / "outputs"};
+  const std::filesystem::path out =
+      args.out.empty() ? study.dir() / "report" : std::filesystem::path(args.out);
+  std::filesystem::create_directories(out);
+  const report::ReportResult result = report::write_study_report(input, out);
+  std::cout << "report: " << result.index.string() << " (" << result.figures.size()
+            << " figures; open it in a browser, it needs no network)\n";
+  if (!result.pending.empty()) {
+    std::cout << "not computed yet:";
+    for (const std::string& section : result.pending) std::cout << ' ' << section;
+    std::cout << " (run the study further, then report again)\n";
+  }
+}
+
+}  // namespace
+
+void register_report_commands(CLI::App& app, const workflow::NodeRegistry& registry) {
+  auto args = std::make_shared<ReportArgs>();
+  auto* report = app.add_subcommand(
+      "report",
+      "The study report for people: index.html with the landmarks and who placed them, scaling, "
+      "motion, wrapping, fibres and provenance (offline: no scripts, no network)");
+  report->add_option("dir", args->dir, "Study folder")->required();
+  report->add_option("-o,--out", args->out, "Report folder (default: STUDY/report)");
+  report->callback([args, &registry] { run_report(*args, registry); });
+}
+
+}  // namespace mmm::app

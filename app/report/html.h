@@ -1,0 +1,21 @@
+#pragma once
+// Small pieces of an offline HTML page: escaped text and plain tables. No
+// scripts, no external resources.
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace mmm::app::report {
+
+// & < > " ' as character references.
+std::string html_escape(std::string_view text);
+
+// <table> with a header row; every cell is escaped text.
+std::string html_table(const std::vector<std::string>& header,
+                       const std::vector<std::vector<std::string>>& rows);
+
+// A number with `decimals` digits after the point ("-" for NaN or infinity).
+std::string fixed(double value, int decimals);
+
+}  // namespace mmm::app::report

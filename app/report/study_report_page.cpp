@@ -1,0 +1,351 @@
+#include "app/report/study_report_page.h"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "app/report/html.h"
+#include "core/errors.h"
+#include "core/plot/svg_plot.h"
+
+namespace mmm::app::report {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InvalidInputError(file.string() + ": cannot be read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::optional<json> read_json(const fs::path& file) {
+  if (!fs::exists(file)) return std::nullopt;
+  try {
+    return json::parse(read_text(file));
+  } catch (const json::parse_error& error) {
+    throw InvalidInputError(file.string() + ": not JSON (" + error.what() +
+                            "); re-run the node that wrote it");
+  }
+}
+
+// Collects the page, the figures and the pending sections as it goes.
+class Page {
+ public:
+  Page(fs::path outputs, fs::path figures)
+      : outputs_(std::move(outputs)), figures_(std::move(figures)) {}
+
+  void add(const std::string& html) { body_ += html; }
+  void heading(const std::string& id, const std::string& title) {
+    body_ += "<section id=\"" + id + "\">\n<h2>" + html_escape(title) + "</h2>\n";
+  }
+  void end_section() { body_ += "</section>\n"; }
+  void paragraph(const std::string& text) { body_ += "<p>" + html_escape(text) + "</p>\n"; }
+  void pending(const std::string& section, const std::string& what) {
+    pending_.push_back(section);
+    body_ += "<p class=\"pending\">Not computed yet: " + html_escape(what) + ".</p>\n";
+  }
+
+  // A PNG of the outputs copied next to the page; false when there is none.
+  bool png(const std::string& name, const std::string& file, const std::string& caption) {
+    const fs::path from = outputs_ / file;
+    if (!fs::exists(from)) return false;
+    fs::copy_file(from, figures_ / file, fs::copy_options::overwrite_existing);
+    figure(name,
+           "<img src=\"figures/" + html_escape(file) + "\" alt=\"" + html_escape(caption) + "\">",
+           caption);
+    return true;
+  }
+  // An SVG of the outputs, inlined; false when there is none.
+  bool svg_file(const std::string& name, const std::string& file, const std::string& caption) {
+    const fs::path from = outputs_ / file;
+    if (!fs::exists(from)) return false;
+    svg(name, read_text(from), caption);
+    return true;
+  }
+  void svg(const std::string& name, std::string svg, const std::string& caption) {
+    const auto start = svg.find("<svg");
+    if (start != std::string::npos) svg.erase(0, start);  // no XML declaration inside HTML
+    figure(name, svg, caption);
+  }
+
+  [[nodiscard]] const fs::path& outputs() const { return outputs_; }
+  [[nodiscard]] const std::vector<std::string>& figures() const { return names_; }
+  [[nodiscard]] const std::vector<std::string>& pending_sections() const { return pending_; }
+  [[nodiscard]] const std::string& body() const { return body_; }
+
+ private:
+  void figure(const std::string& name, const std::string& content, const std::string& caption) {
+    names_.push_back(name);
+    body_ += "<figure data-figure=\"" + html_escape(name) + "\">\n" + content + "\n<figcaption>" +
+             html_escape(caption) + "</figcaption>\n</figure>\n";
+  }
+
+  fs::path outputs_;
+  fs::path figures_;
+  std::string body_;
+  std::vector<std::string> names_;
+  std::vector<std::string> pending_;
+};
+
+std::string text_of(const json& value) {
+  return value.is_string() ? value.get<std::string>() : value.dump();
+}
+
+void landmarks_section(Page& page, const ReportInput& input) {
+  page.heading("landmarks", "Landmarks (landmark station)");
+  std::vector<std::vector<std::string>> rows;
+  for (const json& entry : input.audit) {
+    // The landmarks a submission placed (its pixels are in the audit entry).
+    std::string placed;
+    const json after = entry.value("after", json());
+    if (after.is_object() && after.contains("landmarks") && after["landmarks"].is_object()) {
+      for (const auto& [name, views] : after["landmarks"].items()) {
+        placed += (placed.empty() ? "" : ", ") + name;
+      }
+    }
+    rows.push_back({text_of(entry.value("time", json())), text_of(entry.value("operator", json())),
+                    text_of(entry.value("action", json())), text_of(entry.value("task_id", json())),
+                    placed,
+                    entry.value("reason", json()).is_null() ? "" : text_of(entry["reason"])});
+  }
+  if (rows.empty()) {
+    page.pending("landmarks", "no manual action is recorded in the audit trail");
+  } else {
+    page.paragraph("Who did what, when (the study's audit trail, hash-chained; mmm audit verify):");
+    page.add(html_table({"time (UTC)", "operator", "action", "task", "landmarks placed", "reason"},
+                        rows));
+  }
+  const std::optional<json> landmarks = read_json(page.outputs() / "landmarks.json");
+  if (landmarks) {
+    std::vector<std::vector<std::string>> placed;
+    for (const json& landmark : landmarks->value("landmarks", json::array())) {
+      const json position = landmark.value("position_mm", json::array());
+      std::string errors;
+      const json errors_by_view = landmark.value("reprojection_error_mm", json::object());
+      for (const auto& [view, error] : errors_by_view.items()) {
+        errors += (errors.empty() ? "" : ", ") + view + " " + fixed(error.get<double>(), 2);
+      }
+      placed.push_back({landmark.value("name", ""),
+                        position.size() == 3 ? fixed(position[0].get<double>(), 1) + ", " +
+                                                   fixed(position[1].get<double>(), 1) + ", " +
+                                                   fixed(position[2].get<double>(), 1)
+                                             : "-",
+                        errors});
+    }
+    page.paragraph("The accepted landmarks, triangulated from both views:");
+    page.add(html_table({"landmark", "position (mm)", "reprojection error (mm)"}, placed));
+  }
+  if (!page.png("overlay", "overlay.png",
+                "The scaled bones' outlines over the frontal and lateral radiographs")) {
+    page.pending("overlay", "the scaled atlas over the radiographs (after scaling)");
+  }
+  page.end_section();
+}
+
+void scaling_section(Page& page) {
+  page.heading("scaling", "Scaling");
+  const std::optional<json> report = read_json(page.outputs() / "scaling_report.json");
+  if (!report) {
+    page.pending("scaling", "the scaled atlas (after the landmarks are accepted)");
+    page.end_section();
+    return;
+  }
+  std::vector<std::vector<std::string>> factors;
+  const json first = report->value("first_stage", json::object());
+  const json segment_factors = first.value("segment_length_factor", json::object());
+  for (const auto& [segment, factor] : segment_factors.items()) {
+    factors.push_back({segment, fixed(factor.get<double>(), 3)});
+  }
+  page.paragraph("Per-segment length factors (patient / atlas):");
+  page.add(html_table({"segment", "length factor"}, factors));
+  std::vector<std::vector<std::string>> residuals;
+  const json landmark_residuals = report->value("landmark_residual_mm", json::object());
+  for (const auto& [name, residual] : landmark_residuals.items()) {
+    residuals.push_back({name, fixed(residual.get<double>(), 3)});
+  }
+  page.paragraph("Landmark residuals of the scaled atlas:");
+  page.add(html_table({"landmark", "residual (mm)"}, residuals));
+  page.end_section();
+}
+
+void motion_section(Page& page) {
+  page.heading("motion", "Motion");
+  const bool plot =
+      page.svg_file("angles", "angle_plot.svg",
+                    "Joint angles over the trial (ours and OpenSim's own inverse kinematics)");
+  const std::optional<json> report = read_json(page.outputs() / "motion_report.json");
+  if (!plot && !report) {
+    page.pending("motion", "the retargeted walk (after scaling)");
+  }
+  if (report) {
+    std::vector<std::vector<std::string>> rows;
+    for (const json& c : report->value("fit", json::object()).value("coordinates", json::array())) {
+      rows.push_back({c.value("coordinate", ""), fixed(c.value("min", 0.0), 1),
+                      fixed(c.value("max", 0.0), 1), c.value("unit", "")});
+    }
+    page.paragraph("Range of each fitted coordinate over the trial:");
+    page.add(html_table({"coordinate", "min", "max", "unit"}, rows));
+  }
+  page.end_section();
+}
+
+void wrapping_section(Page& page) {
+  page.heading("wrapping", "Muscle wrapping");
+  const bool plot = page.svg_file(
+      "wrapping", "wrapping_plot.svg",
+      "Per muscle and frame: volume error, depth inside bone, time, smoothness change");
+  const std::optional<json> report = read_json(page.outputs() / "wrapping_report.json");
+  if (!plot && !report) {
+    page.pending("wrapping", "the wrapped muscles (after the motion)");
+  }
+  if (report) {
+    std::vector<std::vector<std::string>> rows;
+    for (const json& m : report->value("muscles", json::array())) {
+      rows.push_back({m.value("muscle", ""), fixed(m.value("max_abs_volume_error_percent", 0.0), 6),
+                      fixed(m.value("max_depth_mm", 0.0), 2),
+                      fixed(m.value("median_ms_per_frame", 0.0), 1)});
+    }
+    page.paragraph("Worst frame per muscle over " + std::to_string(report->value("frames", 0)) +
+                   " frames:");
+    page.add(html_table({"muscle", "volume error (%)", "depth in bone (mm)", "median ms per frame"},
+                        rows));
+  }
+  page.end_section();
+}
+
+// Mean fibre length per muscle and frame, relative to its mean over the trial.
+plot::Chart fibre_length_chart(const fs::path& csv_file) {
+  std::ifstream in(csv_file);
+  std::string line;
+  std::getline(in, line);                                                // header
+  std::map<std::string, std::map<double, std::pair<double, int>>> sums;  // muscle -> time -> sum, n
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream cell_stream(line);
+    for (std::string cell; std::getline(cell_stream, cell, ',');) cells.push_back(cell);
+    if (cells.size() != 6) {
+      throw InvalidInputError(csv_file.string() + ": a row without 6 columns: '" + line + "'");
+    }
+    auto& [sum, n] = sums[cells[0]][std::stod(cells[4])];
+    sum += std::stod(cells[5]);
+    ++n;
+  }
+  plot::Chart chart;
+  chart.title = "Mean fibre length per muscle over the trial";
+  chart.x_label = "time (s)";
+  chart.y_label = "relative to its trial mean (%)";
+  for (const auto& [muscle, by_time] : sums) {
+    plot::Series series;
+    series.label = muscle;
+    double total = 0.0;
+    for (const auto& [time, sum_n] : by_time) total += sum_n.first / sum_n.second;
+    const double mean = total / static_cast<double>(by_time.size());
+    for (const auto& [time, sum_n] : by_time) {
+      series.x.push_back(time);
+      series.y.push_back(100.0 * (sum_n.first / sum_n.second / mean - 1.0));
+    }
+    chart.series.push_back(std::move(series));
+  }
+  chart.y_reference_lines = {0.0};
+  return chart;
+}
+
+void fibres_section(Page& page) {
+  page.heading("fibres", "Muscle fibres");
+  const bool picture =
+      page.png("fibre_picture", "fibre_picture.png", "A muscle with its fibres, front and side");
+  const fs::path lengths = page.outputs() / "fibre_lengths.csv";
+  if (fs::exists(lengths)) {
+    page.svg("fibre_lengths", plot::svg_chart(fibre_length_chart(lengths), 900, 520),
+             "Fibre length curves: each muscle's mean fibre length over the trial");
+  }
+  if (!picture && !fs::exists(lengths)) {
+    page.pending("fibres", "the fibres (after the wrapping)");
+  }
+  page.end_section();
+}
+
+void provenance_section(Page& page, const json& status) {
+  page.heading("provenance", "Provenance");
+  const json meta = status.value("meta", json::object());
+  page.add(html_table(
+      {"study", "workflow", "workflow hash", "mmm", "git revision", "created"},
+      {{status.value("study", ""), status.value("workflow", ""),
+        text_of(meta.value("workflow_hash", json(""))),
+        text_of(meta.value("mmm_version", json(""))), text_of(meta.value("git_revision", json(""))),
+        text_of(meta.value("created_at", json("")))}}));
+  std::vector<std::vector<std::string>> nodes;
+  for (const json& node : status.value("nodes", json::array())) {
+    const json result = node.value("result", json::object());
+    std::string params;
+    const json params_json = node.value("key", json::object()).value("params", json::object());
+    for (const auto& [name, value] : params_json.items()) {
+      params +=
+          (params.empty() ? "" : ", ") + name + "=" +
+          (value.is_object() && !value.empty() ? text_of(value.begin().value()) : text_of(value));
+    }
+    nodes.push_back({node.value("id", ""), node.value("type", ""),
+                     std::to_string(node.value("version", 0)), node.value("state", ""),
+                     result.contains("seconds") ? fixed(result["seconds"].get<double>(), 2) : "-",
+                     node.value("cache_key", std::string()).substr(0, 12), params});
+  }
+  page.paragraph("Nodes (time per stage, cache keys and parameters):");
+  page.add(html_table({"node", "type", "version", "state", "seconds", "cache key", "parameters"},
+                      nodes));
+  std::vector<std::vector<std::string>> inputs;
+  for (const json& in : status.value("inputs", json::array())) {
+    inputs.push_back({in.value("name", ""), in.value("type", ""),
+                      in.value("hash", std::string()).substr(0, 12), in.value("given", "")});
+  }
+  page.paragraph("Inputs (SHA-256 of their content):");
+  page.add(html_table({"input", "type", "hash", "given as"}, inputs));
+  page.end_section();
+}
+
+constexpr const char* kStyle =
+    "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}"
+    "table{border-collapse:collapse;margin:.5em 0 1em}td,th{border:1px solid #ccc;padding:2px 8px;"
+    "font-size:90%;text-align:left}th{background:#f0f0f0}figure{margin:1em 0}"
+    "figure img,figure svg{max-width:100%;height:auto}figure "
+    "img{max-height:90vh}figcaption{color:#555;font-size:90%}"
+    ".pending{color:#a60}";
+
+}  // namespace
+
+ReportResult write_study_report(const ReportInput& input, const fs::path& out) {
+  const fs::path figures = out / "figures";
+  fs::remove_all(figures);
+  fs::create_directories(figures);
+  Page page(input.outputs, figures);
+  landmarks_section(page, input);
+  scaling_section(page);
+  motion_section(page);
+  wrapping_section(page);
+  fibres_section(page);
+  provenance_section(page, input.status);
+  const std::string title = "mmm study report: " + input.status.value("study", std::string());
+  const std::string html =
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      "<title>" +
+      html_escape(title) + "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n<h1>" +
+      html_escape(title) +
+      "</h1>\n<p>State: " + html_escape(input.status.value("state", std::string())) + "</p>\n" +
+      page.body() + "</body>\n</html>\n";
+  ReportResult result{out / "index.html", page.figures(), page.pending_sections()};
+  const fs::path partial = out / "index.html.partial";
+  {
+    std::ofstream file(partial, std::ios::binary);
+    file << html;
+    if (!file) throw InvalidInputError(partial.string() + ": cannot be written");
+  }
+  fs::rename(partial, result.index);
+  return result;
+}
+
+}  // namespace mmm::app::report
