@@ -90,18 +90,6 @@ double median(std::vector<double> values) {
   return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-// Median over the fibres of the distance from one end (first or last point)
-// to the nearest of `points`.
-double end_distance_median(const std::vector<fibres::Fibre>& fibres, const Eigen::MatrixX3d& points,
-                           bool last) {
-  std::vector<double> distances;
-  for (const fibres::Fibre& fibre : fibres) {
-    const Eigen::RowVector3d end = fibre.row(last ? fibre.rows() - 1 : 0);
-    distances.push_back(std::sqrt((points.rowwise() - end).rowwise().squaredNorm().minCoeff()));
-  }
-  return median(distances);
-}
-
 std::string fixed(double value, int decimals) {
   std::ostringstream s;
   s << std::fixed << std::setprecision(decimals) << value;
@@ -133,8 +121,10 @@ nlohmann::json quality_table(std::ostringstream& out) {
           m->rest(), result.fibres, result.attachments.origin, result.attachments.insertion);
       const double gap_o = result.origin_gap_mm;
       const double gap_i = result.insertion_gap_mm;
-      const double bone_o = end_distance_median(result.fibres, result.bone_areas.origin, false);
-      const double bone_i = end_distance_median(result.fibres, result.bone_areas.insertion, true);
+      const fibres::FibreQuality to_bone = fibres::measure_fibre_quality(
+          m->rest(), result.fibres, result.bone_areas.origin, result.bone_areas.insertion);
+      const double bone_o = to_bone.origin_end_distance_median_mm;
+      const double bone_i = to_bone.insertion_end_distance_median_mm;
       inside[method].push_back(q.inside_fraction);
       ends[method].push_back(q.origin_end_distance_median_mm);
       ends[method].push_back(q.insertion_end_distance_median_mm);

@@ -264,11 +264,7 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
         const fibres::MuscleFibres result = model.decompose(
             wrapped.V, [&](const std::string& bone) { return poses.pose(bone, k, frame); });
         frame_seconds += result.seconds;
-        frames_inside =
-            std::min(frames_inside, fibres::measure_fibre_quality(wrapped, result.fibres,
-                                                                  result.attachments.origin,
-                                                                  result.attachments.insertion)
-                                        .inside_fraction);
+        frames_inside = std::min(frames_inside, fibres::inside_fraction(wrapped, result.fibres));
         add_frame(result, static_cast<int>(k), frame.time);
       }
     }

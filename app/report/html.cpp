@@ -4,46 +4,21 @@
 #include <iomanip>
 #include <sstream>
 
-namespace mmm::app::report {
+#include "core/xml_escape.h"
 
-std::string html_escape(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+namespace mmm::app::report {
 
 std::string html_table(const std::vector<std::string>& header,
                        const std::vector<std::vector<std::string>>& rows) {
   std::string out = "<table>\n<tr>";
   for (const std::string& cell : header) {
-    out += "<th>" + html_escape(cell) + "</th>";
+    out += "<th>" + xml_escaped(cell) + "</th>";
   }
   out += "</tr>\n";
   for (const std::vector<std::string>& row : rows) {
     out += "<tr>";
     for (const std::string& cell : row) {
-      out += "<td>" + html_escape(cell) + "</td>";
+      out += "<td>" + xml_escaped(cell) + "</td>";
     }
     out += "</tr>\n";
   }

@@ -8,10 +8,7 @@
 
 namespace mmm::app::report {
 
-// & < > " ' as character references.
-std::string html_escape(std::string_view text);
-
-// <table> with a header row; every cell is escaped text.
+// <table> with a header row; every cell is escaped text (core/xml_escape.h).
 std::string html_table(const std::vector<std::string>& header,
                        const std::vector<std::vector<std::string>>& rows);
 

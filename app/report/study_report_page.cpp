@@ -9,6 +9,7 @@
 #include "app/report/html.h"
 #include "core/errors.h"
 #include "core/plot/svg_plot.h"
+#include "core/xml_escape.h"
 
 namespace mmm::app::report {
 namespace {
@@ -42,13 +43,13 @@ class Page {
 
   void add(const std::string& html) { body_ += html; }
   void heading(const std::string& id, const std::string& title) {
-    body_ += "<section id=\"" + id + "\">\n<h2>" + html_escape(title) + "</h2>\n";
+    body_ += "<section id=\"" + id + "\">\n<h2>" + xml_escaped(title) + "</h2>\n";
   }
   void end_section() { body_ += "</section>\n"; }
-  void paragraph(const std::string& text) { body_ += "<p>" + html_escape(text) + "</p>\n"; }
+  void paragraph(const std::string& text) { body_ += "<p>" + xml_escaped(text) + "</p>\n"; }
   void pending(const std::string& section, const std::string& what) {
     pending_.push_back(section);
-    body_ += "<p class=\"pending\">Not computed yet: " + html_escape(what) + ".</p>\n";
+    body_ += "<p class=\"pending\">Not computed yet: " + xml_escaped(what) + ".</p>\n";
   }
 
   // A PNG of the outputs copied next to the page; false when there is none.
@@ -57,7 +58,7 @@ class Page {
     if (!fs::exists(from)) return false;
     fs::copy_file(from, figures_ / file, fs::copy_options::overwrite_existing);
     figure(name,
-           "<img src=\"figures/" + html_escape(file) + "\" alt=\"" + html_escape(caption) + "\">",
+           "<img src=\"figures/" + xml_escaped(file) + "\" alt=\"" + xml_escaped(caption) + "\">",
            caption);
     return true;
   }
@@ -82,8 +83,8 @@ class Page {
  private:
   void figure(const std::string& name, const std::string& content, const std::string& caption) {
     names_.push_back(name);
-    body_ += "<figure data-figure=\"" + html_escape(name) + "\">\n" + content + "\n<figcaption>" +
-             html_escape(caption) + "</figcaption>\n</figure>\n";
+    body_ += "<figure data-figure=\"" + xml_escaped(name) + "\">\n" + content + "\n<figcaption>" +
+             xml_escaped(caption) + "</figcaption>\n</figure>\n";
   }
 
   fs::path outputs_;
@@ -333,9 +334,9 @@ ReportResult write_study_report(const ReportInput& input, const fs::path& out) {
   const std::string html =
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       "<title>" +
-      html_escape(title) + "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n<h1>" +
-      html_escape(title) +
-      "</h1>\n<p>State: " + html_escape(input.status.value("state", std::string())) + "</p>\n" +
+      xml_escaped(title) + "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n<h1>" +
+      xml_escaped(title) +
+      "</h1>\n<p>State: " + xml_escaped(input.status.value("state", std::string())) + "</p>\n" +
       page.body() + "</body>\n</html>\n";
   ReportResult result{out / "index.html", page.figures(), page.pending_sections()};
   const fs::path partial = out / "index.html.partial";

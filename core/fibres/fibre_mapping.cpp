@@ -165,6 +165,31 @@ ContourFibres contour_sections(const mesh::IndexedMesh& surface, const Eigen::Ve
   return result;
 }
 
+namespace {
+
+// Fibre f extended to the surface points nearest attachment points
+// origin_of[f] and insertion_of[f], smoothed, resampled to `segments` and
+// kept inside `surface`; returns the points moved inside.
+int extend_to_attachments(std::vector<Fibre>& fibres, const mesh::IndexedMesh& surface,
+                          const Attachments& attachments, const std::vector<int>& origin_of,
+                          const std::vector<int>& insertion_of, int segments,
+                          int smoothing_passes) {
+  const mesh::AabbTree tree(surface);
+  const mesh::WindingNumber inside(tree);
+  for (std::size_t f = 0; f < fibres.size(); ++f) {
+    const Vector3d origin_target =
+        tree.closest_point(attachments.origin.row(origin_of[f]).transpose()).point;
+    const Vector3d insertion_target =
+        tree.closest_point(attachments.insertion.row(insertion_of[f]).transpose()).point;
+    Fibre whole = extend_fibre(fibres[f], origin_target, insertion_target);
+    smooth_fibre(whole, smoothing_passes);
+    fibres[f] = resample_fibre(whole, segments);
+  }
+  return keep_inside(fibres, inside, kInsideMarginMm);
+}
+
+}  // namespace
+
 void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
                    const std::vector<Fibre>& mapped, const Attachments& attachments,
                    const DecompositionOptions& options, EndLayout layout) {
@@ -174,45 +199,42 @@ void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
     starts.row(static_cast<Index>(f)) = mapped[f].row(0);
     ends.row(static_cast<Index>(f)) = mapped[f].row(mapped[f].rows() - 1);
   }
-  const std::vector<int> origin_of = match_ends(attachments.origin, starts, result.axes, layout);
-  const std::vector<int> insertion_of =
-      match_ends(attachments.insertion, ends, result.axes, layout);
-  const mesh::AabbTree tree(surface);
-  const mesh::WindingNumber inside(tree);
-  result.fibres.clear();
-  result.fibres.reserve(mapped.size());
-  for (std::size_t f = 0; f < mapped.size(); ++f) {
-    const Vector3d origin_target =
-        tree.closest_point(attachments.origin.row(origin_of[f]).transpose()).point;
-    const Vector3d insertion_target =
-        tree.closest_point(attachments.insertion.row(insertion_of[f]).transpose()).point;
-    Fibre whole = extend_fibre(mapped[f], origin_target, insertion_target);
-    smooth_fibre(whole, options.smoothing_passes);
-    result.fibres.push_back(resample_fibre(whole, options.segments));
-  }
-  result.moved_inside = keep_inside(result.fibres, inside, kInsideMarginMm);
+  result.fibres = mapped;
+  result.moved_inside =
+      extend_to_attachments(result.fibres, surface, attachments,
+                            match_ends(attachments.origin, starts, result.axes, layout),
+                            match_ends(attachments.insertion, ends, result.axes, layout),
+                            options.segments, options.smoothing_passes);
+}
+
+void finish_template_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
+                            const Attachments& attachments, const DecompositionOptions& options,
+                            EndLayout layout) {
+  const std::vector<TemplateFibre> templates =
+      fibre_template(options.architecture, options.fibres, attachments.narrow_at_insertion());
+  finish_fibres(result, surface, fibres_through_contours(result.contours, templates), attachments,
+                options, layout);
 }
 
 int connect_to_nearest_attachments(std::vector<Fibre>& fibres, const mesh::IndexedMesh& surface,
                                    const Attachments& attachments, int segments,
                                    int smoothing_passes) {
-  const mesh::AabbTree tree(surface);
-  const mesh::WindingNumber inside(tree);
-  const auto nearest = [&tree](const Eigen::MatrixX3d& points, const Eigen::RowVector3d& end) {
+  const auto nearest = [](const Eigen::MatrixX3d& points, const Eigen::RowVector3d& end) {
     Index best = 0;
     (points.rowwise() - end).rowwise().squaredNorm().minCoeff(&best);
-    return tree.closest_point(points.row(best).transpose()).point;
+    return static_cast<int>(best);
   };
-  for (Fibre& fibre : fibres) {
+  std::vector<int> origin_of;
+  std::vector<int> insertion_of;
+  for (const Fibre& fibre : fibres) {
     if (fibre.rows() < 2) {
       throw InvalidInputError("connect_to_nearest_attachments: a fibre has fewer than two points");
     }
-    Fibre whole = extend_fibre(fibre, nearest(attachments.origin, fibre.row(0)),
-                               nearest(attachments.insertion, fibre.row(fibre.rows() - 1)));
-    smooth_fibre(whole, smoothing_passes);
-    fibre = resample_fibre(whole, segments);
+    origin_of.push_back(nearest(attachments.origin, fibre.row(0)));
+    insertion_of.push_back(nearest(attachments.insertion, fibre.row(fibre.rows() - 1)));
   }
-  return keep_inside(fibres, inside, kInsideMarginMm);
+  return extend_to_attachments(fibres, surface, attachments, origin_of, insertion_of, segments,
+                               smoothing_passes);
 }
 
 void smooth_fibre(Fibre& fibre, int passes) {

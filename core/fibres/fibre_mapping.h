@@ -59,6 +59,12 @@ void finish_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
                    const std::vector<Fibre>& mapped, const Attachments& attachments,
                    const DecompositionOptions& options, EndLayout layout);
 
+// finish_fibres for the template of options.architecture (narrow end as
+// attachments.narrow_at_insertion) mapped through result.contours.
+void finish_template_fibres(ContourFibres& result, const mesh::IndexedMesh& surface,
+                            const Attachments& attachments, const DecompositionOptions& options,
+                            EndLayout layout);
+
 // Each fibre connected at both ends to the nearest of the attachment points
 // (the cadaver method's "connected to their nearest tendons"): extended
 // (extend_fibre) from its end to the surface point nearest that attachment

@@ -178,6 +178,23 @@ double fit_error(const Fibre& fibre, int degree) {
 
 }  // namespace
 
+double inside_fraction(const mesh::IndexedMesh& surface, const std::vector<Fibre>& fibres,
+                       double surface_tolerance_mm) {
+  const mesh::AabbTree tree(surface);
+  const mesh::WindingNumber winding(tree);
+  const double tolerance_squared = surface_tolerance_mm * surface_tolerance_mm;
+  int inside = 0;
+  int vertices = 0;
+  for (const Fibre& fibre : fibres) {
+    for (Eigen::Index i = 0; i < fibre.rows(); ++i) {
+      const Vector3d q = fibre.row(i).transpose();
+      if (winding.is_inside(q) || tree.closest_point_within(q, tolerance_squared)) ++inside;
+    }
+    vertices += static_cast<int>(fibre.rows());
+  }
+  return vertices > 0 ? static_cast<double>(inside) / vertices : 1.0;
+}
+
 FibreQuality measure_fibre_quality(const mesh::IndexedMesh& surface,
                                    const std::vector<Fibre>& fibres, const Eigen::MatrixX3d& origin,
                                    const Eigen::MatrixX3d& insertion,
@@ -195,19 +212,9 @@ FibreQuality measure_fibre_quality(const mesh::IndexedMesh& surface,
 
   FibreQuality quality;
   quality.fibres = static_cast<int>(fibres.size());
+  for (const Fibre& fibre : fibres) quality.vertices += static_cast<int>(fibre.rows());
   try {
-    const mesh::AabbTree tree(surface);
-    const mesh::WindingNumber winding(tree);
-    const double tolerance_squared = options.surface_tolerance_mm * options.surface_tolerance_mm;
-    int inside = 0;
-    for (const Fibre& fibre : fibres) {
-      for (Eigen::Index i = 0; i < fibre.rows(); ++i) {
-        const Vector3d q = fibre.row(i).transpose();
-        if (winding.is_inside(q) || tree.closest_point_within(q, tolerance_squared)) ++inside;
-      }
-      quality.vertices += static_cast<int>(fibre.rows());
-    }
-    quality.inside_fraction = static_cast<double>(inside) / quality.vertices;
+    quality.inside_fraction = inside_fraction(surface, fibres, options.surface_tolerance_mm);
   } catch (const InvalidInputError& error) {
     throw InvalidInputError(std::string(kWhat) + "muscle surface: " + error.what());
   }

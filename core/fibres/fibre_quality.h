@@ -94,6 +94,12 @@ FibreQuality measure_fibre_quality(const mesh::IndexedMesh& surface,
                                    const Eigen::MatrixX3d& insertion,
                                    const FibreQualityOptions& options = {});
 
+// The inside_fraction of FibreQuality alone (1 for no points): for checks
+// repeated per frame, where the other figures are not needed. Throws
+// InvalidInputError for an invalid surface.
+double inside_fraction(const mesh::IndexedMesh& surface, const std::vector<Fibre>& fibres,
+                       double surface_tolerance_mm = FibreQualityOptions{}.surface_tolerance_mm);
+
 // A flat JSON object whose keys are the field names above, e.g.
 // {"fibres": 81, "inside_fraction": 1.0, "spacing_cv": 0.12, ...}. The
 // second form is nlohmann's hook (`nlohmann::json j = quality;`). Include

@@ -4,7 +4,6 @@
 
 #include "core/errors.h"
 #include "core/fibres/fibre_mapping.h"
-#include "core/fibres/fibre_templates.h"
 
 namespace mmm::fibres {
 
@@ -22,10 +21,7 @@ HarmonicResult harmonic_fibres(const mesh::IndexedMesh& surface, const Attachmen
   }
   HarmonicResult result = contour_sections(
       surface, field, levels, muscle_axes(surface, attachments), options.contour_points);
-  const std::vector<TemplateFibre> templates =
-      fibre_template(options.architecture, options.fibres, attachments.narrow_at_insertion());
-  finish_fibres(result, surface, fibres_through_contours(result.contours, templates), attachments,
-                options, EndLayout::kAttachmentPlane);
+  finish_template_fibres(result, surface, attachments, options, EndLayout::kAttachmentPlane);
   return result;
 }
 

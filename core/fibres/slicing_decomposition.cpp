@@ -38,10 +38,7 @@ SlicingResult slicing_fibres(const mesh::IndexedMesh& surface, const Attachments
   const SlicingPlanes planes = slicing_planes(surface, attachments, axes, options.segments);
   SlicingResult result =
       contour_sections(surface, planes.vertex_heights, planes.levels, axes, options.contour_points);
-  const std::vector<TemplateFibre> templates =
-      fibre_template(options.architecture, options.fibres, attachments.narrow_at_insertion());
-  finish_fibres(result, surface, fibres_through_contours(result.contours, templates), attachments,
-                options, EndLayout::kCrossSection);
+  finish_template_fibres(result, surface, attachments, options, EndLayout::kCrossSection);
   return result;
 }
 

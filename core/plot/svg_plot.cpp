@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "core/file_bytes.h"
 #include "core/plot/nice_ticks.h"
+#include "core/xml_escape.h"
 
 namespace mmm::plot {
 
@@ -67,38 +68,7 @@ std::string shortest(double value) {
   return {buffer.data(), end};
 }
 
-// --- XML ---------------------------------------------------------------
-
-// Text or attribute value with the five XML specials escaped. Control
-// characters other than tab/newline/return are not allowed in XML 1.0 at
-// all (not even as references): they become spaces.
-void append_escaped(std::string& out, std::string_view text) {
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20U && c != '\t' && c != '\n' && c != '\r') {
-          out += ' ';
-        } else {
-          out += c;
-        }
-    }
-  }
-}
+// --- XML (text escaped by core/xml_escape.h) ---------------------------
 
 // Writes one element: Tag(out, "line").attr("x1", 3.5).empty();
 class Tag {
@@ -111,7 +81,7 @@ class Tag {
     out_ += ' ';
     out_ += name;
     out_ += "=\"";
-    append_escaped(out_, value);
+    append_xml_escaped(out_, value);
     out_ += '"';
     return *this;
   }
@@ -121,7 +91,7 @@ class Tag {
   // <name ...>text</name>
   void text(std::string_view content) {
     out_ += '>';
-    append_escaped(out_, content);
+    append_xml_escaped(out_, content);
     out_ += "</";
     out_ += name_;
     out_ += ">\n";
