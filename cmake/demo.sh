@@ -73,7 +73,7 @@ fi
 
 "$mmm" status "$study"
 stage "the study report"
-"$mmm" report "$study"
+"$mmm" report "$study" --truth "$patient" -j "$jobs"
 cat <<EOT
 == mmm demo: done ==
   Report:   $study/report/index.html  (open it in a browser; it needs no network)

@@ -17,14 +17,19 @@ namespace {
 struct ReportArgs {
   std::string dir;
   std::string out;
+  std::string truth;
+  int threads = 2;
 };
 
 void run_report(const ReportArgs& args, const workflow::NodeRegistry& registry) {
   workflow::Study study = workflow::Study::open(args.dir, registry);
   worklists::prepare_audit_tables(study.database());
-  report::ReportInput input{study_status(study),
-                            worklists::audit_to_json(worklists::read_audit(study.database())),
-                            study.dir() / "outputs"};
+  report::ReportInput input;
+  input.status = study_status(study);
+  input.audit = worklists::audit_to_json(worklists::read_audit(study.database()));
+  input.outputs = study.dir() / "outputs";
+  if (!args.truth.empty()) input.truth = args.truth;
+  input.threads = args.threads;
   const std::filesystem::path out =
       args.out.empty() ? study.dir() / "report" : std::filesystem::path(args.out);
   std::filesystem::create_directories(out);
@@ -48,6 +53,13 @@ void register_report_commands(CLI::App& app, const workflow::NodeRegistry& regis
       "motion, wrapping, fibres and provenance (offline: no scripts, no network)");
   report->add_option("dir", args->dir, "Study folder")->required();
   report->add_option("-o,--out", args->out, "Report folder (default: STUDY/report)");
+  report
+      ->add_option("--truth", args->truth,
+                   "A synthetic patient's folder (mmm patient synth -o): adds the landmark and "
+                   "surface errors against its ground truth")
+      ->check(CLI::ExistingDirectory);
+  report->add_option("-j,--threads", args->threads, "Threads for the ground-truth comparison")
+      ->check(CLI::Range(1, 256));
   report->callback([args, &registry] { run_report(*args, registry); });
 }
 

@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 
+#include "app/report/ground_truth.h"
 #include "app/report/html.h"
 #include "core/errors.h"
 #include "core/plot/svg_plot.h"
@@ -141,6 +142,7 @@ void landmarks_section(Page& page, const ReportInput& input) {
     }
     page.paragraph("The accepted landmarks, triangulated from both views:");
     page.add(html_table({"landmark", "position (mm)", "reprojection error (mm)"}, placed));
+    if (input.truth) page.add(truth_landmarks_html(page.outputs(), *input.truth));
   }
   if (!page.png("overlay", "overlay.png",
                 "The scaled bones' outlines over the frontal and lateral radiographs")) {
@@ -149,7 +151,7 @@ void landmarks_section(Page& page, const ReportInput& input) {
   page.end_section();
 }
 
-void scaling_section(Page& page) {
+void scaling_section(Page& page, const ReportInput& input) {
   page.heading("scaling", "Scaling");
   const std::optional<json> report = read_json(page.outputs() / "scaling_report.json");
   if (!report) {
@@ -172,7 +174,25 @@ void scaling_section(Page& page) {
   }
   page.paragraph("Landmark residuals of the scaled atlas:");
   page.add(html_table({"landmark", "residual (mm)"}, residuals));
+  if (input.truth) page.add(truth_surfaces_html(page.outputs(), *input.truth, input.threads));
   page.end_section();
+}
+
+// Per marker: how far the model's marker is from the measured one.
+void marker_residuals(Page& page, const json& fit) {
+  std::vector<std::vector<std::string>> rows;
+  for (const json& m : fit.value("markers", json::array())) {
+    rows.push_back({m.value("marker", ""), fixed(m.value("rms_mm", 0.0), 1),
+                    fixed(m.value("max_mm", 0.0), 1),
+                    std::to_string(m.value("frames_present", 0))});
+  }
+  if (rows.empty()) return;
+  page.paragraph("Marker residuals (model marker to measured marker): RMS " +
+                 fixed(fit.value("marker_rms_mm", 0.0), 1) + " mm over all markers and frames, " +
+                 "per-frame RMS median " +
+                 fixed(fit.value("marker_rms_per_frame_median_mm", 0.0), 1) + " mm, worst frame " +
+                 fixed(fit.value("marker_rms_per_frame_max_mm", 0.0), 1) + " mm.");
+  page.add(html_table({"marker", "RMS (mm)", "max (mm)", "frames"}, rows));
 }
 
 void motion_section(Page& page) {
@@ -192,8 +212,37 @@ void motion_section(Page& page) {
     }
     page.paragraph("Range of each fitted coordinate over the trial:");
     page.add(html_table({"coordinate", "min", "max", "unit"}, rows));
+    marker_residuals(page, report->value("fit", json::object()));
   }
   page.end_section();
+}
+
+// Where the wrapping node's time went, summed over muscles and frames.
+void wrapping_stage_times(Page& page, const json& report) {
+  double hull_s = 0.0;
+  double setup_s = 0.0;
+  for (const json& m : report.value("muscles", json::array())) {
+    hull_s += m.value("hull", json::object()).value("build_s", 0.0);
+    setup_s += m.value("setup_s", 0.0);
+  }
+  const int frames = report.value("frames", 0);
+  const std::size_t muscles = report.value("muscles", json::array()).size();
+  const double total_s = report.value("node_seconds", 0.0);
+  const double median_ms = report.value("median_ms_per_muscle_frame", 0.0);
+  page.paragraph("Time per stage of the wrapping (" + std::to_string(report.value("threads", 0)) +
+                 " threads):");
+  page.add(html_table(
+      {"stage", "seconds"},
+      {{"progressive hulls built here (0 when reused from build_hulls)", fixed(hull_s, 2)},
+       {"per-muscle set-up: decimation, binding, factorisation (summed over muscles)",
+        fixed(setup_s, 2)},
+       {"separating muscles at rest", fixed(report.value("separation_s", 0.0), 2)},
+       {"measuring muscle-muscle penetration", fixed(report.value("muscle_penetration_s", 0.0), 2)},
+       {"median per muscle-frame (ms), over " + std::to_string(muscles) + " muscles x " +
+            std::to_string(frames) + " frames",
+        fixed(median_ms, 1)},
+       {"wrapping every muscle and frame (wall clock)", fixed(report.value("seconds", 0.0), 2)},
+       {"whole node, with reading the atlas and writing the animation", fixed(total_s, 2)}}));
 }
 
 void wrapping_section(Page& page) {
@@ -216,6 +265,7 @@ void wrapping_section(Page& page) {
                    " frames:");
     page.add(html_table({"muscle", "volume error (%)", "depth in bone (mm)", "median ms per frame"},
                         rows));
+    wrapping_stage_times(page, *report);
   }
   page.end_section();
 }
@@ -325,7 +375,7 @@ ReportResult write_study_report(const ReportInput& input, const fs::path& out) {
   fs::create_directories(figures);
   Page page(input.outputs, figures);
   landmarks_section(page, input);
-  scaling_section(page);
+  scaling_section(page, input);
   motion_section(page);
   wrapping_section(page);
   fibres_section(page);

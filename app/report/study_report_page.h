@@ -7,9 +7,13 @@
 //
 //   landmarks   who did what when (audit), the accepted landmarks with their
 //               reprojection errors, the scaled bones over both radiographs
-//   scaling     per-segment length factors, landmark residuals
-//   motion      joint angles over the trial, the fit's coordinate ranges
-//   wrapping    volume error, depth in bone, time per muscle (table + plot)
+//   scaling     per-segment length factors, landmark residuals; for a
+//               synthetic patient (ReportInput::truth) the errors of the
+//               landmarks and of every surface against its ground truth
+//   motion      joint angles over the trial, the fit's coordinate ranges,
+//               marker residuals
+//   wrapping    volume error, depth in bone, time per muscle (table + plot),
+//               time per stage
 //   fibres      a muscle with its fibres, fibre length curves over the trial
 //   provenance  mmm version, workflow hash, per node: type, version, state,
 //               seconds, cache key, parameters; inputs with their hashes
@@ -19,6 +23,7 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +33,10 @@ struct ReportInput {
   nlohmann::json status;  // app::study_status
   nlohmann::json audit;   // worklists::audit_to_json
   std::filesystem::path outputs;
+  // A synthetic patient's folder (mmm patient synth): adds the ground-truth
+  // comparison to the scaling section.
+  std::optional<std::filesystem::path> truth;
+  int threads = 2;
 };
 
 struct ReportResult {
@@ -38,7 +47,7 @@ struct ReportResult {
 
 // Writes out/index.html and out/figures/ (replacing an earlier report there).
 // Throws InvalidInputError naming an output file that exists but cannot be
-// read or parsed.
+// read or parsed, or a truth folder that is not a synthetic patient's.
 ReportResult write_study_report(const ReportInput& input, const std::filesystem::path& out);
 
 }  // namespace mmm::app::report

@@ -147,6 +147,25 @@ TEST_F(StationCliTest, ReportShowsTheAuditAndWhatIsNotComputedYet) {
   EXPECT_EQ(html.find("<script"), std::string::npos);
   EXPECT_EQ(html.find("http"), std::string::npos);
   EXPECT_EQ(run_mmm("report " + (dir_ / "nothing").string()).exit_code, 1);
+
+  // A synthetic patient's truth: the placed landmarks' distances from it
+  // (1 mm and 4 mm off by construction); the surfaces wait for the scaling.
+  const fs::path truth = dir_ / "truth";
+  test::write_file(truth / "ground_truth.json",
+                   R"({"landmarks": {"femoral_head_centre_r": {"position_mm": [91, 0, 900]},
+                                     "patella_centre_r": {"position_mm": [80, 30, 484]}}})");
+  const CommandResult compared =
+      run_mmm("report " + study_.string() + " --truth " + truth.string());
+  ASSERT_EQ(compared.exit_code, 0) << compared.err;
+  const std::string with_truth = test::read_text(study_ / "report/index.html");
+  EXPECT_NE(with_truth.find("<td>femoral_head_centre_r</td><td>1.00</td>"), std::string::npos);
+  EXPECT_NE(with_truth.find("<td>patella_centre_r</td><td>4.00</td>"), std::string::npos);
+  EXPECT_EQ(with_truth.find("Surface distance of every"), std::string::npos);
+  const CommandResult not_a_patient =
+      run_mmm("report " + study_.string() + " --truth " + root_.string());
+  EXPECT_EQ(not_a_patient.exit_code, 1);
+  EXPECT_NE(not_a_patient.err.find("ground_truth.json: missing"), std::string::npos)
+      << not_a_patient.err;
 }
 
 }  // namespace
