@@ -1,5 +1,5 @@
 # mmm: the two commands of the README, and the helpers behind them.
-#   make demo   install what is missing, build (Release), run the default study end to end
+#   make demo   install what is missing, build mmm (Release), run the default study end to end
 #   make test   install what is missing, build (Release), run the whole test suite
 # Other targets: build, deps, bench [SUITE=mesh], format, lint, clean.
 
@@ -24,7 +24,7 @@ WEB_TEST_PACKAGES := chromium
 LINT_PACKAGES := clang-format clang-tidy
 
 
-.PHONY: demo test build deps deps-lint configure bench format lint clean
+.PHONY: demo test build build-mmm deps deps-lint configure bench format lint clean
 
 # The default study end to end (cmake/demo.sh): the default atlas (built when
 # missing or when its recipe changed), synthetic patient 1 with its calibrated
@@ -34,11 +34,11 @@ LINT_PACKAGES := clang-format clang-tidy
 # fibres. MANUAL=1 leaves the landmark task open for a person instead.
 # Interrupt it at any point and run it again: it goes on where it stopped.
 MANUAL ?= 0
-demo: build $(ATLAS_DIR)/atlas.yaml
+demo: build-mmm $(ATLAS_DIR)/atlas.yaml
 	./cmake/demo.sh $(BUILD_DIR)/bin/mmm $(ATLAS_DIR) $(DATA_DIR) $(BUILD_DIR)/demo $(JOBS) $(MANUAL)
 
 # The default atlas: rebuilt when missing or when its recipe changes.
-$(ATLAS_DIR)/atlas.yaml: $(RECIPE) | build
+$(ATLAS_DIR)/atlas.yaml: $(RECIPE) | build-mmm
 	@echo "== mmm demo: building the default atlas from $(RECIPE) =="
 	$(BUILD_DIR)/bin/mmm atlas build $(RECIPE) -o $(ATLAS_DIR) --data $(DATA_DIR)
 
@@ -47,6 +47,10 @@ test: build
 
 build: deps configure
 	cmake --build $(BUILD_DIR) -j $(JOBS)
+
+# Only the mmm command (no tests, no benchmarks): what make demo needs.
+build-mmm: deps configure
+	cmake --build $(BUILD_DIR) -j $(JOBS) --target mmm
 
 configure:
 	cmake -S . -B $(BUILD_DIR) -G Ninja -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DMMM_DATA_DIR=$(DATA_DIR)

@@ -3,9 +3,12 @@
 # end to end. Safe to interrupt and run again at any point: the patient and
 # the study are created once, `mmm run` recomputes only what is missing, and
 # the landmark task is picked up in whatever state it was left.
-#   demo.sh MMM ATLAS_DIR DATA_DIR DEMO_DIR JOBS MANUAL
+#   demo.sh MMM ATLAS_DIR DATA_DIR DEMO_DIR JOBS MANUAL [NODE.PARAM=VALUE ...]
+# The optional settings change the study's parameters (mmm study set) before
+# it runs; the end-to-end test (tests/e2e) walks a shorter part of the trial.
 set -euo pipefail
 mmm=$1 atlas=$2 data=$3 demo=$4 jobs=$5 manual=${6:-0}
+settings=("${@:7}")
 patient=$demo/patient_1
 root=$demo/studies
 study=$root/patient_1
@@ -28,6 +31,9 @@ if [[ ! -f $study/study.db ]]; then
     --input lateral="$patient/radiographs/lateral.png" --input patient=P001 \
     --input model="$data/gait2392/Pipelines/reference/subject01_simbody.osim" \
     --input trial="$data/gait2392/Pipelines/subject01_walk1.trc"
+fi
+if [[ ${#settings[@]} -gt 0 ]]; then
+  "$mmm" study set "$study" "${settings[@]}"  # the same values again change nothing
 fi
 
 stage "run to the landmark station"
