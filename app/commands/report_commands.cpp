@@ -2,6 +2,7 @@
 
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "app/commands/commands.h"
@@ -24,12 +25,12 @@ struct ReportArgs {
 void run_report(const ReportArgs& args, const workflow::NodeRegistry& registry) {
   workflow::Study study = workflow::Study::open(args.dir, registry);
   worklists::prepare_audit_tables(study.database());
-  report::ReportInput input;
-  input.status = study_status(study);
-  input.audit = worklists::audit_to_json(worklists::read_audit(study.database()));
-  input.outputs = study.dir() / "outputs";
-  if (!args.truth.empty()) input.truth = args.truth;
-  input.threads = args.threads;
+  const report::ReportInput input{
+      .status = study_status(study),
+      .audit = worklists::audit_to_json(worklists::read_audit(study.database())),
+      .outputs = study.dir() / "outputs",
+      .truth = args.truth.empty() ? std::nullopt : std::optional<std::filesystem::path>(args.truth),
+      .threads = args.threads};
   const std::filesystem::path out =
       args.out.empty() ? study.dir() / "report" : std::filesystem::path(args.out);
   std::filesystem::create_directories(out);
