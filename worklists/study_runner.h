@@ -4,6 +4,7 @@
 // `mmm task submit` (continuing after an accepted submission) and `mmm serve`
 // (resuming within a second of an acceptance) all go through here.
 
+#include <chrono>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,10 +22,15 @@ struct StudyRunResult {
   std::vector<Task> opened;  // tasks opened after the run
 };
 
+// How long a runner waits for the study lock by default: `mmm status` and
+// the web server's listings hold it for a moment while they refresh changed
+// inputs, which must not make a run or a task's resume give up.
+inline constexpr std::chrono::milliseconds kBriefLockWait{5000};
+
 // Takes the study's runner lock (waiting up to `wait`), runs it and opens
 // the tasks. When the lock is held by another runner, returns locked = true
 // without running.
 StudyRunResult run_study_with_tasks(workflow::Study& study, const workflow::RunOptions& options,
-                                    std::chrono::milliseconds wait = std::chrono::milliseconds(0));
+                                    std::chrono::milliseconds wait = kBriefLockWait);
 
 }  // namespace mmm::worklists

@@ -87,7 +87,7 @@ void run_set(const SetArgs& args, const workflow::NodeRegistry& registry) {
 struct RunArgs {
   std::string dir;
   int jobs = 1;
-  double wait_seconds = 0;
+  double wait_seconds = 5;  // worklists::kBriefLockWait
   bool quiet = false;
   bool show_cached = false;
 };
@@ -195,7 +195,8 @@ void register_study_commands(CLI::App& app, const workflow::NodeRegistry& regist
   run->add_option("--jobs,-j", run_args->jobs, "Nodes run at the same time")
       ->check(CLI::Range(1, 256));
   run->add_option("--wait", run_args->wait_seconds,
-                  "When another runner holds the study, wait up to SECONDS for it")
+                  "When another runner holds the study, wait up to SECONDS for it (default 5: "
+                  "mmm status holds it for a moment)")
       ->check(CLI::Range(0.0, 1e6));
   run->add_flag("--quiet,-q", run_args->quiet, "Print only the summary");
   run->add_flag("--show-cached", run_args->show_cached, "Print a line for every reused node");

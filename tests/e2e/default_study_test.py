@@ -217,7 +217,7 @@ def main():
     study_b = demo_b / "studies/patient_1"
     kill_demo_when(args, demo_b, log, lambda group: (demo_b / "patient_1").exists(), 2.0,
                    "while making the patient")
-    for node, after_s in (("scaled", 0.5), ("wrap", 3.0), ("fibres", 1.0)):
+    for node, after_s in (("scaled", 0.5), ("wrap", 1.5), ("fibres", 1.0)):
         kill_demo_when(args, demo_b, log,
                        lambda group, n=node: node_running(args, study_b, n, group), after_s,
                        f"while '{node}' ran")

@@ -204,7 +204,7 @@ TEST_F(StudyCliTest, ASecondRunnerExitsOrWaitsAndNothingRunsTwice) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   ASSERT_TRUE(workflow::StudyLock::read_holder(study_).has_value());
-  const CommandResult second = run();
+  const CommandResult second = run(" --wait 0");
   auto third = std::async(std::launch::async, [this] { return run(" --wait 600"); });
   const CommandResult first_result = first.get();
   const CommandResult third_result = third.get();
