@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -87,7 +88,7 @@ void run_set(const SetArgs& args, const workflow::NodeRegistry& registry) {
 struct RunArgs {
   std::string dir;
   int jobs = 1;
-  double wait_seconds = 5;  // worklists::kBriefLockWait
+  double wait_seconds = std::chrono::duration<double>(worklists::kBriefLockWait).count();
   bool quiet = false;
   bool show_cached = false;
 };

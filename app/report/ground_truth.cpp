@@ -3,11 +3,13 @@
 #include <Eigen/Core>
 
 #include <algorithm>
-#include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "app/report/html.h"
+#include "app/report/json_file.h"
 #include "core/atlas/atlas_surface_errors.h"
 #include "core/errors.h"
 #include "core/xml_escape.h"
@@ -18,17 +20,15 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-json read_json_file(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) {
+// A file of the patient folder; a clear error when it is not a patient's.
+json read_patient_json(const fs::path& file) {
+  std::optional<json> parsed =
+      read_json_if_present(file, "make the patient again (mmm patient synth)");
+  if (!parsed) {
     throw InvalidInputError(file.string() +
                             ": missing; --truth takes a folder written by mmm patient synth");
   }
-  try {
-    return json::parse(in);
-  } catch (const json::parse_error& error) {
-    throw InvalidInputError(file.string() + ": not JSON (" + error.what() + ")");
-  }
+  return std::move(*parsed);
 }
 
 Eigen::Vector3d point(const json& value, const std::string& where) {
@@ -40,16 +40,14 @@ Eigen::Vector3d point(const json& value, const std::string& where) {
 
 }  // namespace
 
-std::string truth_landmarks_html(const fs::path& outputs, const fs::path& patient) {
-  const fs::path landmarks_file = outputs / "landmarks.json";
-  if (!fs::exists(landmarks_file)) return {};
+std::string truth_landmarks_html(const json& landmarks, const fs::path& landmarks_file,
+                                 const fs::path& patient) {
   const fs::path truth_file = patient / "ground_truth.json";
-  const json truth = read_json_file(truth_file);
-  const json landmarks = read_json_file(landmarks_file);
+  const json truth = read_patient_json(truth_file);
+  const json true_landmarks = truth.value("landmarks", json::object());
   std::vector<std::vector<std::string>> rows;
   for (const json& landmark : landmarks.value("landmarks", json::array())) {
     const std::string name = landmark.value("name", "");
-    const json true_landmarks = truth.value("landmarks", json::object());
     if (!true_landmarks.contains(name)) {
       throw InvalidInputError(truth_file.string() + ": no landmark '" + name +
                               "' (is this the study's patient?)");

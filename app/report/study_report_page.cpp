@@ -8,6 +8,7 @@
 
 #include "app/report/ground_truth.h"
 #include "app/report/html.h"
+#include "app/report/json_file.h"
 #include "core/errors.h"
 #include "core/plot/svg_plot.h"
 #include "core/xml_escape.h"
@@ -17,24 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InvalidInputError(file.string() + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-std::optional<json> read_json(const fs::path& file) {
-  if (!fs::exists(file)) return std::nullopt;
-  try {
-    return json::parse(read_text(file));
-  } catch (const json::parse_error& error) {
-    throw InvalidInputError(file.string() + ": not JSON (" + error.what() +
-                            "); re-run the node that wrote it");
-  }
-}
 
 // Collects the page, the figures and the pending sections as it goes.
 class Page {
@@ -123,7 +106,7 @@ void landmarks_section(Page& page, const ReportInput& input) {
     page.add(html_table({"time (UTC)", "operator", "action", "task", "landmarks placed", "reason"},
                         rows));
   }
-  const std::optional<json> landmarks = read_json(page.outputs() / "landmarks.json");
+  const std::optional<json> landmarks = read_json_if_present(page.outputs() / "landmarks.json");
   if (landmarks) {
     std::vector<std::vector<std::string>> placed;
     for (const json& landmark : landmarks->value("landmarks", json::array())) {
@@ -142,7 +125,9 @@ void landmarks_section(Page& page, const ReportInput& input) {
     }
     page.paragraph("The accepted landmarks, triangulated from both views:");
     page.add(html_table({"landmark", "position (mm)", "reprojection error (mm)"}, placed));
-    if (input.truth) page.add(truth_landmarks_html(page.outputs(), *input.truth));
+    if (input.truth) {
+      page.add(truth_landmarks_html(*landmarks, page.outputs() / "landmarks.json", *input.truth));
+    }
   }
   if (!page.png("overlay", "overlay.png",
                 "The scaled bones' outlines over the frontal and lateral radiographs")) {
@@ -153,7 +138,7 @@ void landmarks_section(Page& page, const ReportInput& input) {
 
 void scaling_section(Page& page, const ReportInput& input) {
   page.heading("scaling", "Scaling");
-  const std::optional<json> report = read_json(page.outputs() / "scaling_report.json");
+  const std::optional<json> report = read_json_if_present(page.outputs() / "scaling_report.json");
   if (!report) {
     page.pending("scaling", "the scaled atlas (after the landmarks are accepted)");
     page.end_section();
@@ -178,6 +163,25 @@ void scaling_section(Page& page, const ReportInput& input) {
   page.end_section();
 }
 
+// A section's SVG plot and the node report beside it, both from the outputs.
+struct PlotAndReport {
+  std::string section;
+  std::string figure;
+  std::string svg_file;
+  std::string caption;
+  std::string report_file;
+  std::string pending;  // what is missing while neither exists
+};
+
+// Adds the plot when it exists and returns the parsed report; marks the
+// section pending when neither exists.
+std::optional<json> plot_and_report(Page& page, const PlotAndReport& sources) {
+  const bool plot = page.svg_file(sources.figure, sources.svg_file, sources.caption);
+  std::optional<json> report = read_json_if_present(page.outputs() / sources.report_file);
+  if (!plot && !report) page.pending(sources.section, sources.pending);
+  return report;
+}
+
 // Per marker: how far the model's marker is from the measured one.
 void marker_residuals(Page& page, const json& fit) {
   std::vector<std::vector<std::string>> rows;
@@ -197,13 +201,10 @@ void marker_residuals(Page& page, const json& fit) {
 
 void motion_section(Page& page) {
   page.heading("motion", "Motion");
-  const bool plot =
-      page.svg_file("angles", "angle_plot.svg",
-                    "Joint angles over the trial (ours and OpenSim's own inverse kinematics)");
-  const std::optional<json> report = read_json(page.outputs() / "motion_report.json");
-  if (!plot && !report) {
-    page.pending("motion", "the retargeted walk (after scaling)");
-  }
+  const std::optional<json> report = plot_and_report(
+      page, {"motion", "angles", "angle_plot.svg",
+             "Joint angles over the trial (ours and OpenSim's own inverse kinematics)",
+             "motion_report.json", "the retargeted walk (after scaling)"});
   if (report) {
     std::vector<std::vector<std::string>> rows;
     for (const json& c : report->value("fit", json::object()).value("coordinates", json::array())) {
@@ -219,14 +220,15 @@ void motion_section(Page& page) {
 
 // Where the wrapping node's time went, summed over muscles and frames.
 void wrapping_stage_times(Page& page, const json& report) {
+  const json muscle_reports = report.value("muscles", json::array());
   double hull_s = 0.0;
   double setup_s = 0.0;
-  for (const json& m : report.value("muscles", json::array())) {
+  for (const json& m : muscle_reports) {
     hull_s += m.value("hull", json::object()).value("build_s", 0.0);
     setup_s += m.value("setup_s", 0.0);
   }
   const int frames = report.value("frames", 0);
-  const std::size_t muscles = report.value("muscles", json::array()).size();
+  const std::size_t muscles = muscle_reports.size();
   const double total_s = report.value("node_seconds", 0.0);
   const double median_ms = report.value("median_ms_per_muscle_frame", 0.0);
   page.paragraph("Time per stage of the wrapping (" + std::to_string(report.value("threads", 0)) +
@@ -247,13 +249,10 @@ void wrapping_stage_times(Page& page, const json& report) {
 
 void wrapping_section(Page& page) {
   page.heading("wrapping", "Muscle wrapping");
-  const bool plot = page.svg_file(
-      "wrapping", "wrapping_plot.svg",
-      "Per muscle and frame: volume error, depth inside bone, time, smoothness change");
-  const std::optional<json> report = read_json(page.outputs() / "wrapping_report.json");
-  if (!plot && !report) {
-    page.pending("wrapping", "the wrapped muscles (after the motion)");
-  }
+  const std::optional<json> report = plot_and_report(
+      page, {"wrapping", "wrapping", "wrapping_plot.svg",
+             "Per muscle and frame: volume error, depth inside bone, time, smoothness change",
+             "wrapping_report.json", "the wrapped muscles (after the motion)"});
   if (report) {
     std::vector<std::vector<std::string>> rows;
     for (const json& m : report->value("muscles", json::array())) {

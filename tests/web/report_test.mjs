@@ -14,25 +14,10 @@ import assert from "node:assert/strict";
 import fs from "node:fs";
 import path from "node:path";
 import { pathToFileURL } from "node:url";
+import { chromiumOrSkip, parseArgs } from "./browser.mjs";
 
-const args = {};
-for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, "")] = process.argv[i + 1];
-if (!args.report) {
-  console.error("usage: node report_test.mjs --report DIR [--screenshot PNG]");
-  process.exit(2);
-}
-const chromiumPath = process.env.MMM_CHROMIUM || "/usr/bin/chromium";
-if (!fs.existsSync(chromiumPath)) {
-  console.log(`skipped: no Chromium at ${chromiumPath} (apt-get install chromium; or set MMM_CHROMIUM)`);
-  process.exit(77);
-}
-let chromium;
-try {
-  ({ chromium } = await import("playwright-core"));
-} catch {
-  console.log("skipped: playwright-core is not installed (cd tests/web && npm ci)");
-  process.exit(77);
-}
+const args = parseArgs(["report"], "node report_test.mjs --report DIR [--screenshot PNG]");
+const launchChromium = await chromiumOrSkip();
 
 const index = path.resolve(args.report, "index.html");
 assert.ok(fs.existsSync(index), `no report at ${index}: run the end-to-end test first (tests/e2e)`);
@@ -41,7 +26,7 @@ const expectedSections = ["landmarks", "scaling", "motion", "wrapping", "fibres"
 
 let browser = null;
 try {
-  browser = await chromium.launch({ executablePath: chromiumPath, args: ["--no-sandbox"] });
+  browser = await launchChromium();
   const context = await browser.newContext({ offline: true, viewport: { width: 1200, height: 900 } });
   const page = await context.newPage();
   const problems = [];

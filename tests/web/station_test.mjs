@@ -15,27 +15,10 @@ import { execFileSync, spawn } from "node:child_process";
 import assert from "node:assert/strict";
 import fs from "node:fs";
 import path from "node:path";
+import { chromiumOrSkip, parseArgs } from "./browser.mjs";
 
-const args = {};
-for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, "")] = process.argv[i + 1];
-for (const required of ["mmm", "source", "patient", "work"]) {
-  if (!args[required]) {
-    console.error(`usage: node station_test.mjs --mmm BIN --source DIR --patient DIR --work DIR [--screenshot PNG]`);
-    process.exit(2);
-  }
-}
-const chromiumPath = process.env.MMM_CHROMIUM || "/usr/bin/chromium";
-if (!fs.existsSync(chromiumPath)) {
-  console.log(`skipped: no Chromium at ${chromiumPath} (apt-get install chromium; or set MMM_CHROMIUM)`);
-  process.exit(77);
-}
-let chromium;
-try {
-  ({ chromium } = await import("playwright-core"));
-} catch {
-  console.log("skipped: playwright-core is not installed (cd tests/web && npm ci)");
-  process.exit(77);
-}
+const args = parseArgs(["mmm", "source", "patient", "work"], "node station_test.mjs --mmm BIN --source DIR --patient DIR --work DIR [--screenshot PNG]");
+const launchChromium = await chromiumOrSkip();
 
 const started = Date.now();
 const elapsed = () => `${((Date.now() - started) / 1000).toFixed(1)} s`;
@@ -114,7 +97,7 @@ try {
   log(`API: 401 without a valid token; task ${task.id} open`);
 
   // ---- the page ------------------------------------------------------------------
-  browser = await chromium.launch({ executablePath: chromiumPath, args: ["--no-sandbox"] });
+  browser = await launchChromium();
   const page = await browser.newPage({ viewport: { width: 1600, height: 1000 } });
   const pageErrors = [];
   page.on("pageerror", (error) => pageErrors.push(error.message));
