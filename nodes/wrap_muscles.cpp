@@ -29,6 +29,7 @@ wrapping::MuscleWrappingOptions options_from(const workflow::NodeContext& contex
   options.muscle_contacts = context.flag("muscle_contacts");
   options.muscle_contact.weight = context.number("muscle_contact_weight");
   options.muscle_contact_rounds = static_cast<int>(context.integer("muscle_contact_rounds"));
+  options.muscle_interface_reach_mm = context.number("muscle_interface_reach_mm");
   options.intermediate_poses = static_cast<int>(context.integer("intermediate_poses"));
   options.first_frame_intermediate_poses =
       static_cast<int>(context.integer("first_frame_intermediate_poses"));
@@ -134,7 +135,8 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
          {"separation",
           {{"overlap_at_rest_mm", muscle.rest_overlap_before_mm},
            {"overlap_after_mm", muscle.rest_overlap_after_mm},
-           {"max_move_mm", muscle.separation_move_mm}}},
+           {"max_move_mm", muscle.separation_move_mm},
+           {"interface_vertices", muscle.interface_vertices}}},
          {"hull",
           {{"faces", muscle.hull_faces},
            {"reused", muscle.hull_reused},
@@ -177,7 +179,8 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
             {"contact_clearance_mm", options.contacts.clearance_mm},
             {"muscle_contacts", options.muscle_contacts},
             {"muscle_contact_weight", options.muscle_contact.weight},
-            {"muscle_contact_rounds", options.muscle_contact_rounds}}}};
+            {"muscle_contact_rounds", options.muscle_contact_rounds},
+            {"muscle_interface_reach_mm", options.muscle_interface_reach_mm}}}};
 }
 
 std::string animation_bundle(const workflow::NodeContext& context,
@@ -240,7 +243,7 @@ workflow::NodeSpec WrapMuscles::spec() {
   using workflow::port::File;
   using workflow::port::Report;
   const wrapping::MuscleWrappingOptions d;
-  return workflow::NodeSpec{"wrap_muscles", 2,
+  return workflow::NodeSpec{"wrap_muscles", 3,
                             "Muscle wrapping over a fused motion (energy pathway): per frame, "
                             "action lines re-routed on the "
                             "moving skeleton; each muscle surface deformed around them with its "
@@ -272,6 +275,11 @@ workflow::NodeSpec WrapMuscles::spec() {
                      {.min = 0.01, .max = 1e6})
       .param<std::int64_t>("muscle_contact_rounds", d.muscle_contact_rounds,
                            "Rounds of contacts between muscles per pose", {.min = 1, .max = 10})
+      .param<double>("muscle_interface_reach_mm", d.muscle_interface_reach_mm,
+                     "With muscle_contacts: muscles this close at rest share their motion "
+                     "across the interface, so the skeleton does not drive them into each "
+                     "other (0: each follows its own action lines)",
+                     {.min = 0, .max = 100}, "mm")
       .param_enum("path_method", "obstacle_set", {"obstacle_set", "global"},
                   "Action-line paths: straight between the path points and wrapped over the "
                   "atlas's fitted obstacles, or the shortest path keeping clear of the bone "

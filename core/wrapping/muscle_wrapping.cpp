@@ -18,6 +18,7 @@
 #include "core/motion/skeleton.h"
 #include "core/parallel_for.h"
 #include "core/wrapping/hull_embedding.h"
+#include "core/wrapping/muscle_interfaces.h"
 #include "core/wrapping/muscle_penetration.h"
 #include "core/wrapping/muscle_separation.h"
 
@@ -354,9 +355,20 @@ class MuscleWrapper {
   [[nodiscard]] const MatrixX3d& current() const { return solved_.x; }
   [[nodiscard]] const Eigen::MatrixX3i& faces() const { return result_.rest.F; }
   [[nodiscard]] const MatrixX3d& rest_vertices() const { return result_.rest.V; }
+  // The prepared pose's targets, and the same blended with the other
+  // muscles' across their interfaces (muscle_interfaces.h): all[n] is muscle
+  // n's own in this pose.
+  [[nodiscard]] const MuscleBinding::Targets& targets() const { return targets_; }
+  void blend_targets(const std::vector<InterfaceLink>& links,
+                     const std::vector<const MuscleBinding::Targets*>& all) {
+    const Clock::time_point start = Clock::now();
+    targets_ = blend_interfaces(targets_, links, all, fine_.binding->bone_blend());
+    frame_seconds_ += seconds_since(start);
+  }
 
   // Contacts between muscles: this muscle's index among the wrapped ones.
   void set_index(int index) { index_ = index; }
+  void set_interface_vertices(int count) { result_.interface_vertices = count; }
   void set_separation(double overlap_before_mm, double overlap_after_mm, double max_move_mm) {
     result_.rest_overlap_before_mm = overlap_before_mm;
     result_.rest_overlap_after_mm = overlap_after_mm;
@@ -502,11 +514,13 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
     const MuscleContactOptions& c = options.muscle_contact;
     if (!(c.share >= 0.0 && c.share <= 1.0) || !(c.weight > 0.0) || !std::isfinite(c.weight) ||
         !(c.reach_mm > 0.0) || !(c.tolerance_mm >= 0.0) || options.muscle_contact_rounds < 1 ||
-        options.separation_rounds < 1 || !(options.separation_weight > 0.0) ||
-        !std::isfinite(options.separation_weight)) {
+        !(options.muscle_interface_reach_mm >= 0.0) ||
+        !std::isfinite(options.muscle_interface_reach_mm) || options.separation_rounds < 1 ||
+        !(options.separation_weight > 0.0) || !std::isfinite(options.separation_weight)) {
       throw InvalidInputError(
           "muscle wrapping: muscle contacts need a share in [0, 1], weights > 0, reach > 0, "
-          "tolerance >= 0 and at least one round (muscle_contact_rounds, separation_rounds)");
+          "tolerance >= 0, an interface reach >= 0 and at least one round "
+          "(muscle_contact_rounds, separation_rounds)");
     }
   }
   const std::vector<const atlas::Muscle*> muscles = selected_muscles(atlas, options.muscles);
@@ -570,12 +584,33 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
       wrappers[m]->set_index(static_cast<int>(m));
       faces.push_back(&wrappers[m]->faces());
     }
+    // Touching muscles share their motion across the interface (measured
+    // on the separated rest surfaces).
+    std::vector<std::vector<InterfaceLink>> interfaces;
+    if (options.muscle_interface_reach_mm > 0.0) {
+      std::vector<MatrixX3d> rest;
+      rest.reserve(wrappers.size());
+      for (const std::unique_ptr<MuscleWrapper>& wrapper : wrappers)
+        rest.push_back(wrapper->rest_vertices());
+      interfaces = muscle_interfaces(MuscleSurfaces(rest, faces, threads),
+                                     options.muscle_interface_reach_mm, threads);
+      for (std::size_t m = 0; m < muscles.size(); ++m)
+        wrappers[m]->set_interface_vertices(static_cast<int>(interfaces[m].size()));
+    }
     for (const VectorXd& q : frames) {
       const int stages = wrappers.front()->stages();
       for (int stage = 1; stage <= stages; ++stage) {
         const VectorXd q_stage = wrappers.front()->stage_coordinates(q, stage);
+        parallel_for(muscles.size(), threads,
+                     [&](std::size_t m) { wrappers[m]->prepare_stage(q_stage, stage == stages); });
+        std::vector<MuscleBinding::Targets> unblended(muscles.size());
+        std::vector<const MuscleBinding::Targets*> own_targets;
+        for (std::size_t m = 0; m < muscles.size(); ++m) {
+          unblended[m] = wrappers[m]->targets();
+          own_targets.push_back(&unblended[m]);
+        }
         parallel_for(muscles.size(), threads, [&](std::size_t m) {
-          wrappers[m]->prepare_stage(q_stage, stage == stages);
+          if (!interfaces.empty()) wrappers[m]->blend_targets(interfaces[m], own_targets);
           wrappers[m]->solve_stage();
         });
         // Rounds of shared contacts, each found on the last round's

@@ -51,9 +51,14 @@ struct MuscleWrappingOptions {
   // solve pinned (two overlapping muscles meet between their surfaces) and new
   // entries into the others found inside the iterations. The muscles go pose
   // by pose together (frame-major). Implies the muscle_penetration metric.
+  // Before the contacts, touching muscles share their motion across their
+  // interface (muscle_interfaces.h): the vertices within
+  // `muscle_interface_reach_mm` of another muscle at rest blend its motion
+  // into their targets (0: each muscle follows its own lines alone).
   bool muscle_contacts = false;
   MuscleContactOptions muscle_contact;
-  int muscle_contact_rounds = 2;  // >= 1
+  int muscle_contact_rounds = 2;            // >= 1
+  double muscle_interface_reach_mm = 20.0;  // >= 0
   // Separation at rest: firmer pins than in motion, more rounds.
   double separation_weight = 1e3;
   int separation_rounds = 12;
@@ -139,6 +144,9 @@ struct WrappedMuscle {
   double rest_overlap_before_mm = 0.0;
   double rest_overlap_after_mm = 0.0;
   double separation_move_mm = 0.0;
+  // With muscle contacts: the vertices that share a neighbour's motion
+  // (muscle_interfaces.h).
+  int interface_vertices = 0;
 };
 
 struct MuscleWrapping {

@@ -250,8 +250,11 @@ TEST(WrapMusclesNodeTest, WithMuscleContactsOverlappingMusclesAreSeparatedAndKep
     EXPECT_NEAR(muscle["separation"]["overlap_at_rest_mm"].get<double>(), 3.0, 0.3);
     EXPECT_LT(muscle["separation"]["overlap_after_mm"].get<double>(), 0.3);
     EXPECT_GT(muscle["separation"]["max_move_mm"].get<double>(), 0.5);
+    // Touching after the separation: each shares its neighbour's motion near the interface.
+    EXPECT_GT(muscle["separation"]["interface_vertices"].get<int>(), 0);
   }
   EXPECT_GE(report["separation_rounds"].get<int>(), 1);
+  EXPECT_EQ(report["options"]["muscle_interface_reach_mm"].get<double>(), 20.0);
   EXPECT_LT(report["max_depth_in_other_muscles_mm"].get<double>(), 1.0);
   EXPECT_LT(report["max_abs_volume_error_percent"].get<double>(), 1e-5);
   EXPECT_LE(report["max_depth_mm"].get<double>(), 0.1 + 1e-9);
@@ -303,6 +306,23 @@ TEST(WrapMusclesNodeTest, AMotionThatIsNotJsonIsRefusedNamingTheInput) {
           {{"atlas", harness.add(PortType::kAtlas, pack_directory(harness.folder() / "toy"))},
            {"motion", harness.add(PortType::kBonePoses, "not json {")}}),
       InvalidInputError);
+}
+
+TEST(WrapMusclesNodeTest, TouchingMusclesShareTheirMotionAcrossTheInterfaceUnlessTheReachIsZero) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.6, 3.0);
+  const auto run = [&](double reach) {
+    const auto outputs =
+        harness.run<WrapMuscles>({{"atlas", toy.atlas}, {"motion", toy.motion}},
+                                 {{"muscle_contacts", true}, {"muscle_interface_reach_mm", reach}});
+    return nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+  };
+  const nlohmann::json alone = run(0.0);
+  const nlohmann::json shared = run(20.0);
+  for (std::size_t m = 0; m < 2; ++m) {
+    EXPECT_EQ(alone["muscles"][m]["separation"]["interface_vertices"].get<int>(), 0);
+    EXPECT_GT(shared["muscles"][m]["separation"]["interface_vertices"].get<int>(), 0);
+  }
 }
 
 }  // namespace
