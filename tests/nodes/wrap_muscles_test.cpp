@@ -323,6 +323,7 @@ TEST(WrapMusclesNodeTest, TouchingMusclesShareTheirMotionAcrossTheInterfaceUnles
     EXPECT_EQ(alone["muscles"][m]["separation"]["interface_vertices"].get<int>(), 0);
     EXPECT_GT(shared["muscles"][m]["separation"]["interface_vertices"].get<int>(), 0);
   }
+  EXPECT_THROW((void)run(-1.0), std::exception);  // a negative reach is refused
 }
 
 }  // namespace
