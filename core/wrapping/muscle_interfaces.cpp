@@ -59,13 +59,13 @@ MuscleBinding::Targets blend_interfaces(const MuscleBinding::Targets& own,
                                         const Eigen::VectorXd& bone_blend) {
   MuscleBinding::Targets blended = own;
   for (const InterfaceLink& link : links) {
+    const double beta = link.weight * (1.0 - bone_blend[link.vertex]);
+    if (beta <= 0.0) continue;
     const MuscleBinding::Targets& other = *all[static_cast<std::size_t>(link.muscle)];
     const auto u = static_cast<std::size_t>(link.other_vertex);
     const Eigen::Matrix3d& turn = other.rotations[u];
     const Eigen::Vector3d carried =
         other.positions.row(link.other_vertex).transpose() + turn * link.offset;
-    const double beta = link.weight * (1.0 - bone_blend[link.vertex]);
-    if (beta <= 0.0) continue;
     const auto v = static_cast<std::size_t>(link.vertex);
     blended.positions.row(link.vertex) =
         (1.0 - beta) * own.positions.row(link.vertex) + beta * carried.transpose();

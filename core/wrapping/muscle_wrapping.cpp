@@ -603,11 +603,16 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
         const VectorXd q_stage = wrappers.front()->stage_coordinates(q, stage);
         parallel_for(muscles.size(), threads,
                      [&](std::size_t m) { wrappers[m]->prepare_stage(q_stage, stage == stages); });
-        std::vector<MuscleBinding::Targets> unblended(muscles.size());
+        // Each muscle blends against the others' own targets, copied
+        // before any is blended (only when there are interfaces).
+        std::vector<MuscleBinding::Targets> unblended;
         std::vector<const MuscleBinding::Targets*> own_targets;
-        for (std::size_t m = 0; m < muscles.size(); ++m) {
-          unblended[m] = wrappers[m]->targets();
-          own_targets.push_back(&unblended[m]);
+        if (!interfaces.empty()) {
+          unblended.reserve(muscles.size());
+          for (const std::unique_ptr<MuscleWrapper>& wrapper : wrappers) {
+            unblended.push_back(wrapper->targets());
+            own_targets.push_back(&unblended.back());
+          }
         }
         parallel_for(muscles.size(), threads, [&](std::size_t m) {
           if (!interfaces.empty()) wrappers[m]->blend_targets(interfaces[m], own_targets);
