@@ -230,24 +230,36 @@ std::vector<Contact> MusclePins::of(std::size_t muscle) const {
   return contacts;
 }
 
-std::vector<Contact> muscle_entries(int self, const Eigen::MatrixX3d& x,
-                                    const std::vector<char>& active, const MuscleSurfaces& others,
-                                    const MuscleContactOptions& options,
-                                    const MuscleClearance* clearance) {
-  std::map<Eigen::Index, std::pair<double, Contact>> deepest;  // vertex -> depth, contact
+std::vector<MuscleOverlap> muscle_overlaps(int self, const Eigen::MatrixX3d& x,
+                                           const std::vector<char>& active,
+                                           const MuscleSurfaces& others,
+                                           const MuscleContactOptions& options,
+                                           const MuscleClearance* clearance) {
+  std::map<Eigen::Index, MuscleOverlap> deepest;  // by vertex
   for_each_inside(
       self, x, others,
       [&](int n, Eigen::Index v, double depth, const mesh::AabbTree::ClosestPoint& closest) {
         if (active[static_cast<std::size_t>(v)] != 0 || depth <= options.tolerance_mm) return;
         const auto found = deepest.find(v);
-        if (found != deepest.end() && found->second.first >= depth) return;
-        deepest[v] = {
-            depth, Contact{static_cast<int>(v), closest.point, muscle_obstacle(n), options.weight}};
+        if (found != deepest.end() && found->second.depth >= depth) return;
+        deepest[v] = {static_cast<int>(v), n,    closest.face, closest.barycentric,
+                      closest.point,       depth};
       },
       options.reach_mm, nullptr, clearance);
+  std::vector<MuscleOverlap> overlaps;
+  overlaps.reserve(deepest.size());
+  for (const auto& [vertex, overlap] : deepest) overlaps.push_back(overlap);
+  return overlaps;
+}
+
+std::vector<Contact> muscle_entries(int self, const Eigen::MatrixX3d& x,
+                                    const std::vector<char>& active, const MuscleSurfaces& others,
+                                    const MuscleContactOptions& options,
+                                    const MuscleClearance* clearance) {
   std::vector<Contact> contacts;
-  contacts.reserve(deepest.size());
-  for (const auto& [vertex, entry] : deepest) contacts.push_back(entry.second);
+  for (const MuscleOverlap& overlap : muscle_overlaps(self, x, active, others, options, clearance))
+    contacts.push_back(
+        {overlap.vertex, overlap.point, muscle_obstacle(overlap.other), options.weight});
   return contacts;
 }
 

@@ -121,6 +121,27 @@ class MusclePins {
   std::vector<std::map<int, Contact>> pins_;
 };
 
+// A vertex of one muscle inside another: the muscle it entered, the nearest
+// point of that muscle's surface (on `face`, with barycentric weights of its
+// corners F(face, 0..2)) and the depth (mm).
+struct MuscleOverlap {
+  int vertex = -1;
+  int other = -1;
+  int face = -1;
+  Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  double depth = 0.0;
+};
+
+// Vertices of muscle `self` (x) not flagged in `active` deeper than the
+// tolerance (and within reach) inside another muscle of `others`, the deepest
+// muscle per vertex; `clearance` spares the vertices that cannot have entered.
+std::vector<MuscleOverlap> muscle_overlaps(int self, const Eigen::MatrixX3d& x,
+                                           const std::vector<char>& active,
+                                           const MuscleSurfaces& others,
+                                           const MuscleContactOptions& options,
+                                           const MuscleClearance* clearance = nullptr);
+
 // Vertices of muscle `self` (x) not flagged in `active` that lie deeper than
 // the tolerance inside another muscle of `others`, pinned to that muscle's
 // nearest surface point (the deepest muscle per vertex counts): new entries

@@ -18,6 +18,7 @@
 #include "core/motion/skeleton.h"
 #include "core/parallel_for.h"
 #include "core/wrapping/hull_embedding.h"
+#include "core/wrapping/joint_deformer.h"
 #include "core/wrapping/muscle_interfaces.h"
 #include "core/wrapping/muscle_penetration.h"
 #include "core/wrapping/muscle_separation.h"
@@ -351,6 +352,28 @@ class MuscleWrapper {
     result_.frames.push_back(metrics);
   }
 
+  // This muscle's part of a joint solve of touching muscles, in the
+  // prepared pose, from its last solve (joint_deformer.h).
+  [[nodiscard]] JointBody joint_body() {
+    JointBody body;
+    body.deformer = fine_.deformer.get();
+    body.right_hand_side = fine_.deformer->right_hand_side(targets_.positions, targets_.rotations);
+    body.start = solved_.x;
+    body.contacts = solved_.contacts;
+    if (options_.bone_contacts) {
+      body.query = [this](const MatrixX3d& x, const std::vector<char>& active) {
+        return fine_.contacts->find(x, poses_, active);
+      };
+    }
+    return body;
+  }
+  // Its result, and its share of the joint solve's time.
+  void take_joint_solve(DeformResult solved, double seconds) {
+    solved_ = std::move(solved);
+    fine_.carried = solved_.contacts;
+    frame_seconds_ += seconds;
+  }
+
   // The surface after the last solve (world, mm).
   [[nodiscard]] const MatrixX3d& current() const { return solved_.x; }
   [[nodiscard]] const Eigen::MatrixX3i& faces() const { return result_.rest.F; }
@@ -514,13 +537,13 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
     const MuscleContactOptions& c = options.muscle_contact;
     if (!(c.share >= 0.0 && c.share <= 1.0) || !(c.weight > 0.0) || !std::isfinite(c.weight) ||
         !(c.reach_mm > 0.0) || !(c.tolerance_mm >= 0.0) || options.muscle_contact_rounds < 1 ||
-        !(options.muscle_interface_reach_mm >= 0.0) ||
+        options.joint_rounds < 1 || !(options.muscle_interface_reach_mm >= 0.0) ||
         !std::isfinite(options.muscle_interface_reach_mm) || options.separation_rounds < 1 ||
         !(options.separation_weight > 0.0) || !std::isfinite(options.separation_weight)) {
       throw InvalidInputError(
           "muscle wrapping: muscle contacts need a share in [0, 1], weights > 0, reach > 0, "
           "tolerance >= 0, an interface reach >= 0 and at least one round "
-          "(muscle_contact_rounds, separation_rounds)");
+          "(muscle_contact_rounds, joint_rounds, separation_rounds)");
     }
   }
   const std::vector<const atlas::Muscle*> muscles = selected_muscles(atlas, options.muscles);
@@ -618,6 +641,22 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
           if (!interfaces.empty()) wrappers[m]->blend_targets(interfaces[m], own_targets);
           wrappers[m]->solve_stage();
         });
+        if (options.joint_muscle_contacts) {
+          const Clock::time_point joint_start = Clock::now();
+          std::vector<JointBody> bodies(muscles.size());
+          parallel_for(muscles.size(), threads,
+                       [&](std::size_t m) { bodies[m] = wrappers[m]->joint_body(); });
+          JointOptions joint;
+          joint.coupling = options.muscle_contact;
+          joint.max_rounds = options.joint_rounds;
+          joint.threads = threads;
+          JointResult solved = solve_jointly(bodies, joint);
+          // Thread time, shared out evenly.
+          const double share = seconds_since(joint_start) * threads / muscles.size();
+          for (std::size_t m = 0; m < muscles.size(); ++m)
+            wrappers[m]->take_joint_solve(std::move(solved.bodies[m]), share);
+          continue;
+        }
         // Rounds of shared contacts, each found on the last round's
         // surfaces and added to the pins of the rounds before.
         MusclePins pins(muscles.size());

@@ -57,7 +57,13 @@ struct MuscleWrappingOptions {
   // into their targets (0: each muscle follows its own lines alone).
   bool muscle_contacts = false;
   MuscleContactOptions muscle_contact;
-  int muscle_contact_rounds = 2;            // >= 1
+  int muscle_contact_rounds = 2;  // >= 1
+  // Instead of those rounds, the muscles that run into each other are solved
+  // together (joint_deformer.h): each vertex found inside another muscle is
+  // tied to that muscle's surface, both move in one solve, and new entries
+  // are looked for on the current surfaces, for up to `joint_rounds` solves.
+  bool joint_muscle_contacts = false;
+  int joint_rounds = 10;                    // >= 1
   double muscle_interface_reach_mm = 20.0;  // >= 0
   // Separation at rest: firmer pins than in motion, more rounds.
   double separation_weight = 1e3;

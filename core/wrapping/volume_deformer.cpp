@@ -212,10 +212,9 @@ class ContactSolver {
 
 }  // namespace
 
-DeformResult VolumeDeformer::solve(const MatrixX3d& targets,
-                                   const std::vector<Eigen::Matrix3d>& rotations,
-                                   std::vector<Contact> contacts, const ContactQuery& query) const {
-  State& s = *state_;
+MatrixX3d VolumeDeformer::right_hand_side(const MatrixX3d& targets,
+                                          const std::vector<Eigen::Matrix3d>& rotations) const {
+  const State& s = *state_;
   const auto n = s.rest.V.rows();
   if (targets.rows() != n || !targets.allFinite()) {
     throw InvalidInputError("volume deformer: targets must be " + std::to_string(n) +
@@ -225,6 +224,24 @@ DeformResult VolumeDeformer::solve(const MatrixX3d& targets,
     throw InvalidInputError("volume deformer: " + std::to_string(rotations.size()) +
                             " rotations for " + std::to_string(n) + " vertices");
   }
+  MatrixX3d detail = s.rest_detail;
+  if (!rotations.empty()) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      detail.row(i) =
+          (rotations[static_cast<std::size_t>(i)] * s.rest_detail.row(i).transpose()).transpose();
+    }
+  }
+  return s.laplacian * detail + s.tie_weight * targets;
+}
+
+const Eigen::SparseMatrix<double>& VolumeDeformer::energy_matrix() const { return state_->matrix; }
+const DeformerOptions& VolumeDeformer::options() const { return state_->options; }
+
+DeformResult VolumeDeformer::solve(const MatrixX3d& targets,
+                                   const std::vector<Eigen::Matrix3d>& rotations,
+                                   std::vector<Contact> contacts, const ContactQuery& query) const {
+  State& s = *state_;
+  const auto n = s.rest.V.rows();
   std::vector<char> active(static_cast<std::size_t>(n), 0);
   auto accept = [&](std::vector<Contact>& candidates) {
     std::vector<Contact> fresh;
@@ -244,14 +261,7 @@ DeformResult VolumeDeformer::solve(const MatrixX3d& targets,
     return fresh;
   };
 
-  MatrixX3d detail = s.rest_detail;
-  if (!rotations.empty()) {
-    for (Eigen::Index i = 0; i < n; ++i) {
-      detail.row(i) =
-          (rotations[static_cast<std::size_t>(i)] * s.rest_detail.row(i).transpose()).transpose();
-    }
-  }
-  const MatrixX3d fixed_rhs = s.laplacian * detail + s.tie_weight * targets;
+  const MatrixX3d fixed_rhs = right_hand_side(targets, rotations);
 
   const std::lock_guard lock(s.solve_mutex);
   ContactSolver solver(s, n);

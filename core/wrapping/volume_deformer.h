@@ -38,6 +38,7 @@
 // moves volume elsewhere instead of losing it.
 
 #include <Eigen/Geometry>
+#include <Eigen/SparseCore>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -104,6 +105,14 @@ class VolumeDeformer {
   [[nodiscard]] const mesh::IndexedMesh& rest() const;
   [[nodiscard]] double rest_volume() const;
   [[nodiscard]] double tie_weight() const;  // w
+
+  // The parts of the energy, for solving several surfaces together
+  // (joint_deformer.h): A = L^T L + w I, and L D + w T for the given targets
+  // and rotations (checked as by solve), so that E = x^T A x - 2 x . b + const.
+  [[nodiscard]] const Eigen::SparseMatrix<double>& energy_matrix() const;
+  [[nodiscard]] Eigen::MatrixX3d right_hand_side(
+      const Eigen::MatrixX3d& targets, const std::vector<Eigen::Matrix3d>& rotations) const;
+  [[nodiscard]] const DeformerOptions& options() const;
 
   struct State;  // the factored energy; defined in the .cpp only
 

@@ -277,6 +277,22 @@ TEST(WrapMusclesNodeTest, WithMuscleContactsOverlappingMusclesAreSeparatedAndKep
   EXPECT_LT(std::stod(fields[8]), 1.0) << row;
 }
 
+TEST(WrapMusclesNodeTest, TheJointContactSolverKeepsTheMusclesApartAndIsRecorded) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.6, 3.0);
+  const auto outputs =
+      harness.run<WrapMuscles>({{"atlas", toy.atlas}, {"motion", toy.motion}},
+                               {{"muscle_contacts", true}, {"muscle_contact_solver", "joint"}});
+  const nlohmann::json report =
+      nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+  EXPECT_EQ(report["options"]["muscle_contact_solver"], "joint");
+  EXPECT_EQ(report["options"]["joint_contact_rounds"].get<int>(), 10);
+  EXPECT_LT(report["max_depth_in_other_muscles_mm"].get<double>(), 0.2);
+  EXPECT_LT(report["max_abs_volume_error_percent"].get<double>(), 1e-5);
+  EXPECT_LE(report["max_depth_mm"].get<double>(), 0.1 + 1e-9);
+  EXPECT_EQ(report["unconverged_muscle_frames"], 0);
+}
+
 TEST(WrapMusclesNodeTest, AMotionOfAnOpenSimModelIsRefusedWithAHint) {
   test::NodeHarness harness;
   const mmm::test::ToyLeg leg = mmm::test::toy_leg();
