@@ -210,13 +210,27 @@ nlohmann::json write_variants_table(std::ostringstream& out, const WalkSummary& 
     std::string name;
     wrapping::MuscleWrappingOptions options;
   };
-  std::vector<Variant> variants(3);
+  std::vector<Variant> variants(4);
   variants[0].name = "direct (no hull)";
   variants[0].options.coarse_to_fine = false;
   variants[1].name = "global paths";
   variants[1].options.routing.method = wrapping::PathMethod::kGlobal;
   variants[2].name = "muscle contacts";
   variants[2].options.muscle_contacts = true;
+  variants[3].name = "muscle contacts, joint";
+  variants[3].options.muscle_contacts = true;
+  variants[3].options.joint_muscle_contacts = true;
+  // MMM_BENCH_WRAPPING_VARIANTS: the 0-based indices of the variants to run
+  // ("2,3"); unset: all of them.
+  if (const char* only = std::getenv("MMM_BENCH_WRAPPING_VARIANTS"); only != nullptr) {
+    std::vector<Variant> chosen;
+    std::istringstream list(only);
+    for (std::string index; std::getline(list, index, ',');) {
+      const auto k = static_cast<std::size_t>(std::stoul(index));
+      if (k < variants.size()) chosen.push_back(variants[k]);
+    }
+    variants = std::move(chosen);
+  }
   out << "\nvariants over the same walk\n"
       << std::left << std::setw(26) << "variant" << std::setw(14) << "|vol err| %" << std::setw(12)
       << "depth mm" << std::setw(14) << "max bending %" << std::setw(12) << "median ms"
