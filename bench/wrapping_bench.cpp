@@ -210,7 +210,7 @@ nlohmann::json write_variants_table(std::ostringstream& out, const WalkSummary& 
     std::string name;
     wrapping::MuscleWrappingOptions options;
   };
-  std::vector<Variant> variants(4);
+  std::vector<Variant> variants(5);
   variants[0].name = "direct (no hull)";
   variants[0].options.coarse_to_fine = false;
   variants[1].name = "global paths";
@@ -220,6 +220,9 @@ nlohmann::json write_variants_table(std::ostringstream& out, const WalkSummary& 
   variants[3].name = "muscle contacts, joint";
   variants[3].options.muscle_contacts = true;
   variants[3].options.joint_muscle_contacts = true;
+  variants[4].name = "muscle contacts, settled";
+  variants[4].options.muscle_contacts = true;
+  variants[4].options.muscle_contact_settling_rounds = 6;
   // MMM_BENCH_WRAPPING_VARIANTS: the 0-based indices of the variants to run
   // ("2,3"); unset: all of them.
   if (const char* only = std::getenv("MMM_BENCH_WRAPPING_VARIANTS"); only != nullptr) {

@@ -29,6 +29,8 @@ wrapping::MuscleWrappingOptions options_from(const workflow::NodeContext& contex
   options.muscle_contacts = context.flag("muscle_contacts");
   options.muscle_contact.weight = context.number("muscle_contact_weight");
   options.muscle_contact_rounds = static_cast<int>(context.integer("muscle_contact_rounds"));
+  options.muscle_contact_settling_rounds =
+      static_cast<int>(context.integer("muscle_contact_settling_rounds"));
   options.joint_muscle_contacts = context.text("muscle_contact_solver") == "joint";
   options.joint_rounds = static_cast<int>(context.integer("joint_contact_rounds"));
   options.muscle_interface_reach_mm = context.number("muscle_interface_reach_mm");
@@ -182,6 +184,7 @@ nlohmann::json report_of(const wrapping::MuscleWrapping& wrapped,
             {"muscle_contacts", options.muscle_contacts},
             {"muscle_contact_weight", options.muscle_contact.weight},
             {"muscle_contact_rounds", options.muscle_contact_rounds},
+            {"muscle_contact_settling_rounds", options.muscle_contact_settling_rounds},
             {"muscle_contact_solver", options.joint_muscle_contacts ? "joint" : "rounds"},
             {"joint_contact_rounds", options.joint_rounds},
             {"muscle_interface_reach_mm", options.muscle_interface_reach_mm}}}};
@@ -279,11 +282,16 @@ workflow::NodeSpec WrapMuscles::spec() {
                      {.min = 0.01, .max = 1e6})
       .param<std::int64_t>("muscle_contact_rounds", d.muscle_contact_rounds,
                            "Rounds of contacts between muscles per pose", {.min = 1, .max = 10})
+      .param<std::int64_t>("muscle_contact_settling_rounds", d.muscle_contact_settling_rounds,
+                           "Rounds solver: after those rounds, while a muscle is still inside "
+                           "another, up to this many in which only such muscles move, pinned "
+                           "onto the surface they entered as firmly as to a bone (0: none)",
+                           {.min = 0, .max = 50})
       .param_enum("muscle_contact_solver", "rounds", {"rounds", "joint"},
                   "With muscle_contacts: rounds of shared pins, each muscle solved against the "
                   "others' surfaces of the round before; or the touching muscles solved together "
-                  "in one system, both sides of a contact moving at once (closer and smoother, "
-                  "several times slower)")
+                  "in one system, both sides of a contact moving at once (smoother, many times "
+                  "slower)")
       .param<std::int64_t>("joint_contact_rounds", d.joint_rounds,
                            "Joint solver: solves per pose with the contacts grown",
                            {.min = 1, .max = 50})

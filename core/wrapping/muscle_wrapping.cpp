@@ -458,8 +458,10 @@ class MuscleWrapper {
     if (pins != nullptr) {
       std::vector<char> taken(static_cast<std::size_t>(level.deformer->rest().V.rows()), 0);
       for (const Contact& contact : contacts) taken[static_cast<std::size_t>(contact.vertex)] = 1;
+      const std::vector<char> in_bone = pins_into_bone(level, *pins, poses);
       for (const Contact& pin : *pins) {
-        if (taken[static_cast<std::size_t>(pin.vertex)] == 0) contacts.push_back(pin);
+        const auto v = static_cast<std::size_t>(pin.vertex);
+        if (taken[v] == 0 && in_bone[v] == 0) contacts.push_back(pin);
       }
     }
     ContactQuery query;
@@ -481,6 +483,27 @@ class MuscleWrapper {
         level.deformer->solve(targets.positions, targets.rotations, std::move(contacts), query);
     level.carried = solved.contacts;
     return solved;
+  }
+
+  // Per vertex: 1 where a pin of another muscle would hold it inside a bone
+  // (a muscle squeezed between a bone and another muscle gives way to the
+  // muscle, never into the bone); only with settling rounds, whose firm pins
+  // would otherwise press it in.
+  std::vector<char> pins_into_bone(const Level& level, const std::vector<Contact>& pins,
+                                   const std::vector<Isometry3d>& poses) const {
+    std::vector<char> in_bone(static_cast<std::size_t>(level.deformer->rest().V.rows()), 0);
+    if (!options_.bone_contacts || options_.muscle_contact_settling_rounds == 0 || pins.empty() ||
+        solved_.x.rows() != static_cast<Eigen::Index>(in_bone.size()))
+      return in_bone;
+    MatrixX3d at_targets = solved_.x;
+    std::vector<char> others(in_bone.size(), 1);
+    for (const Contact& pin : pins) {
+      at_targets.row(pin.vertex) = pin.target.transpose();
+      others[static_cast<std::size_t>(pin.vertex)] = 0;
+    }
+    for (const Contact& inside : level.contacts->find(at_targets, poses, others))
+      in_bone[static_cast<std::size_t>(inside.vertex)] = 1;
+    return in_bone;
   }
 
   const atlas::Muscle& muscle_;
@@ -537,13 +560,14 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
     const MuscleContactOptions& c = options.muscle_contact;
     if (!(c.share >= 0.0 && c.share <= 1.0) || !(c.weight > 0.0) || !std::isfinite(c.weight) ||
         !(c.reach_mm > 0.0) || !(c.tolerance_mm >= 0.0) || options.muscle_contact_rounds < 1 ||
-        options.joint_rounds < 1 || !(options.muscle_interface_reach_mm >= 0.0) ||
+        options.muscle_contact_settling_rounds < 0 || options.joint_rounds < 1 ||
+        !(options.muscle_interface_reach_mm >= 0.0) ||
         !std::isfinite(options.muscle_interface_reach_mm) || options.separation_rounds < 1 ||
         !(options.separation_weight > 0.0) || !std::isfinite(options.separation_weight)) {
       throw InvalidInputError(
           "muscle wrapping: muscle contacts need a share in [0, 1], weights > 0, reach > 0, "
-          "tolerance >= 0, an interface reach >= 0 and at least one round "
-          "(muscle_contact_rounds, joint_rounds, separation_rounds)");
+          "tolerance >= 0, an interface reach >= 0, at least one round "
+          "(muscle_contact_rounds, joint_rounds, separation_rounds) and settling rounds >= 0");
     }
   }
   const std::vector<const atlas::Muscle*> muscles = selected_muscles(atlas, options.muscles);
@@ -658,22 +682,26 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
           continue;
         }
         // Rounds of shared contacts, each found on the last round's
-        // surfaces and added to the pins of the rounds before.
+        // surfaces and added to the pins of the rounds before; then the
+        // settling rounds, where only the muscles still inside another move.
         MusclePins pins(muscles.size());
-        for (int round = 0; round < options.muscle_contact_rounds; ++round) {
+        const int ramp = options.muscle_contact_rounds;
+        for (int round = 0; round < ramp + options.muscle_contact_settling_rounds; ++round) {
           std::vector<MatrixX3d> positions;
           positions.reserve(wrappers.size());
           for (const std::unique_ptr<MuscleWrapper>& wrapper : wrappers)
             positions.push_back(wrapper->current());
           const MuscleSurfaces posed(positions, faces, threads);
           MuscleContactOptions round_contact = options.muscle_contact;
-          round_contact.share =
-              round_share(round_contact.share, round, options.muscle_contact_rounds);
+          const bool settling = round >= ramp;
+          round_contact.share = settling ? 1.0 : round_share(round_contact.share, round, ramp);
+          if (settling) round_contact.weight = options.deformer.contact_weight;
           std::vector<MuscleClearance> clearances;
-          if (!pins.add(
-                  shared_muscle_contacts(positions, posed, round_contact, threads, &clearances)))
-            break;
+          const std::vector<std::vector<Contact>> found =
+              shared_muscle_contacts(positions, posed, round_contact, threads, &clearances);
+          if (!pins.add(found)) break;
           parallel_for(muscles.size(), threads, [&](std::size_t m) {
+            if (settling && found[m].empty()) return;  // not inside another: it stands
             const std::vector<Contact> own = pins.of(m);
             wrappers[m]->solve_stage(&posed, &own, &clearances[m]);
           });

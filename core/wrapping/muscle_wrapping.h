@@ -58,6 +58,14 @@ struct MuscleWrappingOptions {
   bool muscle_contacts = false;
   MuscleContactOptions muscle_contact;
   int muscle_contact_rounds = 2;  // >= 1
+  // Then, while a muscle is still inside another, up to
+  // `muscle_contact_settling_rounds` more in which only such muscles are
+  // solved again, each pinned onto the surface it entered as firmly as to a
+  // bone (deformer.contact_weight) while that surface holds still: the shares
+  // were taken in the rounds before; what is left is settled one-sided.
+  // With settling rounds, a pin that would hold a vertex inside a bone is
+  // dropped, in every round.
+  int muscle_contact_settling_rounds = 0;  // >= 0
   // Instead of those rounds, the muscles that run into each other are solved
   // together (joint_deformer.h): each vertex found inside another muscle is
   // tied to that muscle's surface, both move in one solve, and new entries

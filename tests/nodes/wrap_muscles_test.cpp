@@ -40,11 +40,12 @@ struct ToyLegAndWalk {
 };
 
 // A second vastus beside the first, overlapping it by `overlap` mm at rest.
-void add_neighbour(mmm::test::ToyLeg& leg, double overlap) {
+void add_neighbour(mmm::test::ToyLeg& leg, double overlap,
+                   const Eigen::Vector3d& side = Eigen::Vector3d::UnitX()) {
   atlas::Muscle neighbour = leg.atlas.muscles.front();
   const std::string first = neighbour.name;
   neighbour.name = "vastus_b_r";
-  const Eigen::Vector3d shift(20.0 - overlap, 0, 0);
+  const Eigen::Vector3d shift = (20.0 - overlap) * side;
   for (atlas::MeshLevel& level : neighbour.meshes) {
     level.file = "meshes/vastus_b_r/" + level.level + ".ply";
     mesh::IndexedMesh moved = leg.meshes.at(first).at(level.level);
@@ -85,10 +86,11 @@ void add_insertion(mmm::test::ToyLeg& leg) {
 }
 
 ToyLegAndWalk toy_leg_and_walk(test::NodeHarness& harness, double end_time,
-                               double neighbour_overlap = -1.0, bool with_insertion = false) {
+                               double neighbour_overlap = -1.0, bool with_insertion = false,
+                               const Eigen::Vector3d& neighbour_side = Eigen::Vector3d::UnitX()) {
   ToyLegAndWalk result{mmm::test::toy_leg(), {}, {}};
   if (with_insertion) add_insertion(result.leg);
-  if (neighbour_overlap >= 0.0) add_neighbour(result.leg, neighbour_overlap);
+  if (neighbour_overlap >= 0.0) add_neighbour(result.leg, neighbour_overlap, neighbour_side);
   for (const auto& [name, x] : {std::pair{"R.ASIS", 150.0}, {"L.ASIS", -60.0}}) {
     result.leg.atlas.markers.push_back({name, "pelvis", Eigen::Vector3d(x, 30, 20), true});
   }
@@ -275,6 +277,31 @@ TEST(WrapMusclesNodeTest, WithMuscleContactsOverlappingMusclesAreSeparatedAndKep
   ASSERT_GT(fields.size(), 8U);
   EXPECT_FALSE(fields[8].empty()) << row;
   EXPECT_LT(std::stod(fields[8]), 1.0) << row;
+}
+
+TEST(WrapMusclesNodeTest, SettlingRoundsTakeTheMusclesOutOfEachOtherAndAreRecorded) {
+  // The neighbour in front of the toy vastus: the knee moves them differently.
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.6, 3.0, false, Eigen::Vector3d::UnitZ());
+  const auto run = [&](std::int64_t settling) {
+    const auto outputs = harness.run<WrapMuscles>({{"atlas", toy.atlas}, {"motion", toy.motion}},
+                                                  {{"muscle_contacts", true},
+                                                   {"muscle_contact_rounds", std::int64_t{1}},
+                                                   {"muscle_contact_weight", 1.0},
+                                                   {"muscle_interface_reach_mm", 0.0},
+                                                   {"muscle_contact_settling_rounds", settling}});
+    return nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+  };
+  // One soft round leaves the muscles more than half a millimetre inside each other.
+  const nlohmann::json unsettled = run(0);
+  EXPECT_GT(unsettled["max_depth_in_other_muscles_mm"].get<double>(), 0.4);
+  const nlohmann::json settled = run(6);
+  EXPECT_EQ(settled["options"]["muscle_contact_settling_rounds"].get<int>(), 6);
+  EXPECT_LT(settled["max_depth_in_other_muscles_mm"].get<double>(), 0.2);
+  EXPECT_LT(settled["max_abs_volume_error_percent"].get<double>(), 1e-5);
+  EXPECT_LE(settled["max_depth_mm"].get<double>(), 0.1 + 1e-9);
+  EXPECT_EQ(settled["unconverged_muscle_frames"], 0);
+  EXPECT_THROW((void)run(-1), std::exception);  // a negative count is refused
 }
 
 TEST(WrapMusclesNodeTest, TheJointContactSolverKeepsTheMusclesApartAndIsRecorded) {
