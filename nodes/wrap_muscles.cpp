@@ -250,7 +250,7 @@ workflow::NodeSpec WrapMuscles::spec() {
   using workflow::port::File;
   using workflow::port::Report;
   const wrapping::MuscleWrappingOptions d;
-  return workflow::NodeSpec{"wrap_muscles", 3,
+  return workflow::NodeSpec{"wrap_muscles", 4,
                             "Muscle wrapping over a fused motion (energy pathway): per frame, "
                             "action lines re-routed on the "
                             "moving skeleton; each muscle surface deformed around them with its "
@@ -285,7 +285,8 @@ workflow::NodeSpec WrapMuscles::spec() {
       .param<std::int64_t>("muscle_contact_settling_rounds", d.muscle_contact_settling_rounds,
                            "Rounds solver: after those rounds, while a muscle is still inside "
                            "another, up to this many in which only such muscles move, pinned "
-                           "onto the surface they entered as firmly as to a bone (0: none)",
+                           "onto the surface they entered as firmly as to a bone; each pose "
+                           "keeps the surfaces with the shallowest entry (0: none)",
                            {.min = 0, .max = 50})
       .param_enum("muscle_contact_solver", "rounds", {"rounds", "joint"},
                   "With muscle_contacts: rounds of shared pins, each muscle solved against the "

@@ -204,6 +204,27 @@ std::vector<std::vector<Contact>> shared_muscle_contacts(
   return contacts;
 }
 
+double longest_move(const std::vector<std::vector<Contact>>& found,
+                    const std::vector<Eigen::MatrixX3d>& positions) {
+  if (found.size() != positions.size()) {
+    throw InvalidInputError("muscle contacts: contacts for " + std::to_string(found.size()) +
+                            " muscles, positions for " + std::to_string(positions.size()));
+  }
+  double longest = 0.0;
+  for (std::size_t m = 0; m < found.size(); ++m) {
+    for (const Contact& contact : found[m]) {
+      if (contact.vertex < 0 || contact.vertex >= positions[m].rows()) {
+        throw InvalidInputError("muscle contacts: vertex " + std::to_string(contact.vertex) +
+                                " of muscle " + std::to_string(m) + " outside its " +
+                                std::to_string(positions[m].rows()) + " vertices");
+      }
+      longest =
+          std::max(longest, (contact.target - positions[m].row(contact.vertex).transpose()).norm());
+    }
+  }
+  return longest;
+}
+
 double round_share(double share, int round, int rounds) {
   const double first = std::max(share, 1.0 - share);
   if (rounds <= 1) return first;

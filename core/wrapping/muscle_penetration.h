@@ -107,6 +107,13 @@ std::vector<std::vector<Contact>> shared_muscle_contacts(
 // not deformable) is still resolved by the other.
 double round_share(double share, int round, int rounds);
 
+// The longest move any of `found` asks of its vertex (mm; 0 when none):
+// with all of each overlap to the entering side, the deepest entry into
+// another muscle. found[m]: muscle m's contacts on positions[m]. Throws
+// InvalidInputError for sizes or vertices that do not match.
+double longest_move(const std::vector<std::vector<Contact>>& found,
+                    const std::vector<Eigen::MatrixX3d>& positions);
+
 // Shared contacts gathered over rounds, per muscle: a vertex keeps its latest
 // pin.
 class MusclePins {

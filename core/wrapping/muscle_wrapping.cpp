@@ -374,6 +374,14 @@ class MuscleWrapper {
     frame_seconds_ += seconds;
   }
 
+  // The last solve, and a way back to it (settling rounds keep the pose's
+  // best surfaces).
+  [[nodiscard]] const DeformResult& last_solve() const { return solved_; }
+  void restore_solve(const DeformResult& solved) {
+    solved_ = solved;
+    fine_.carried = solved_.contacts;
+  }
+
   // The surface after the last solve (world, mm).
   [[nodiscard]] const MatrixX3d& current() const { return solved_.x; }
   [[nodiscard]] const Eigen::MatrixX3i& faces() const { return result_.rest.F; }
@@ -684,9 +692,16 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
         // Rounds of shared contacts, each found on the last round's
         // surfaces and added to the pins of the rounds before; then the
         // settling rounds, where only the muscles still inside another move.
+        // Settling moves only one side and can overshoot, so the pose keeps
+        // the surfaces whose deepest entry into another muscle was the
+        // shallowest, measured before every settling round and after the last.
         MusclePins pins(muscles.size());
         const int ramp = options.muscle_contact_rounds;
-        for (int round = 0; round < ramp + options.muscle_contact_settling_rounds; ++round) {
+        const int settling_rounds = options.muscle_contact_settling_rounds;
+        const int last_round = ramp + settling_rounds - (settling_rounds > 0 ? 0 : 1);
+        double best_depth = std::numeric_limits<double>::infinity();
+        std::vector<DeformResult> best;
+        for (int round = 0; round <= last_round; ++round) {
           std::vector<MatrixX3d> positions;
           positions.reserve(wrappers.size());
           for (const std::unique_ptr<MuscleWrapper>& wrapper : wrappers)
@@ -699,6 +714,18 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
           std::vector<MuscleClearance> clearances;
           const std::vector<std::vector<Contact>> found =
               shared_muscle_contacts(positions, posed, round_contact, threads, &clearances);
+          if (settling) {
+            const double depth = longest_move(found, positions);
+            if (depth < best_depth) {
+              best_depth = depth;
+              best.clear();
+              for (const std::unique_ptr<MuscleWrapper>& wrapper : wrappers)
+                best.push_back(wrapper->last_solve());
+            } else if (round == last_round) {
+              for (std::size_t m = 0; m < muscles.size(); ++m) wrappers[m]->restore_solve(best[m]);
+            }
+            if (round == last_round) break;  // measured only
+          }
           if (!pins.add(found)) break;
           parallel_for(muscles.size(), threads, [&](std::size_t m) {
             if (settling && found[m].empty()) return;  // not inside another: it stands

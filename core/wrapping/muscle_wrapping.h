@@ -63,8 +63,10 @@ struct MuscleWrappingOptions {
   // solved again, each pinned onto the surface it entered as firmly as to a
   // bone (deformer.contact_weight) while that surface holds still: the shares
   // were taken in the rounds before; what is left is settled one-sided.
-  // With settling rounds, a pin that would hold a vertex inside a bone is
-  // dropped, in every round.
+  // Settling can overshoot, so each pose keeps the surfaces whose deepest
+  // entry into another muscle was the shallowest (measured before every
+  // settling round and after the last). With settling rounds, a pin that
+  // would hold a vertex inside a bone is dropped, in every round.
   int muscle_contact_settling_rounds = 0;  // >= 0
   // Instead of those rounds, the muscles that run into each other are solved
   // together (joint_deformer.h): each vertex found inside another muscle is

@@ -302,6 +302,15 @@ TEST(WrapMusclesNodeTest, SettlingRoundsTakeTheMusclesOutOfEachOtherAndAreRecord
   EXPECT_LE(settled["max_depth_mm"].get<double>(), 0.1 + 1e-9);
   EXPECT_EQ(settled["unconverged_muscle_frames"], 0);
   EXPECT_THROW((void)run(-1), std::exception);  // a negative count is refused
+  // Each pose keeps its best surfaces over the rounds: more rounds never
+  // leave the muscles deeper inside each other.
+  double deeper = unsettled["max_depth_in_other_muscles_mm"].get<double>();
+  for (const std::int64_t rounds : {1, 2, 3}) {
+    const double depth = run(rounds)["max_depth_in_other_muscles_mm"].get<double>();
+    EXPECT_LE(depth, deeper + 1e-9) << rounds << " settling rounds";
+    deeper = depth;
+  }
+  EXPECT_LE(settled["max_depth_in_other_muscles_mm"].get<double>(), deeper + 1e-9);
 }
 
 TEST(WrapMusclesNodeTest, TheJointContactSolverKeepsTheMusclesApartAndIsRecorded) {

@@ -158,6 +158,26 @@ TEST(MuscleContactsTest, TwoOverlappingMusclesAreToMeetOnThePlaneBetweenThem) {
   EXPECT_TRUE(apart[1].empty());
 }
 
+TEST(MuscleContactsTest, TheLongestMoveIsTheDeepestEntryWhenTheEnteringSideTakesItAll) {
+  // Sphere A's tip (x near 10) lies about 2 mm inside the block B (x >= 8);
+  // with all of the overlap to A, B's corners stay and A's tip moves out to
+  // the block's face x = 8.
+  const mesh::IndexedMesh a = sphere_at({0, 0, 0});
+  const mesh::IndexedMesh b = mesh::make_box({8.0, -20.0, -20.0}, {28.0, 20.0, 20.0});
+  const MuscleSurfaces now = surfaces_of(a, b);
+  MuscleContactOptions all;
+  all.share = 1.0;
+  const std::vector<std::vector<Contact>> found = shared_muscle_contacts({a.V, b.V}, now, all, 1);
+  ASSERT_FALSE(found[0].empty());
+  EXPECT_NEAR(longest_move(found, {a.V, b.V}), a.V.col(0).maxCoeff() - 8.0, 1e-9);
+  EXPECT_GT(longest_move(found, {a.V, b.V}), 1.5);
+  EXPECT_DOUBLE_EQ(longest_move({{}, {}}, {a.V, b.V}), 0.0);
+  EXPECT_THROW((void)longest_move(found, {a.V}), InvalidInputError);
+  std::vector<std::vector<Contact>> bad = found;
+  bad[0][0].vertex = static_cast<int>(a.V.rows());
+  EXPECT_THROW((void)longest_move(bad, {a.V, b.V}), InvalidInputError);
+}
+
 TEST(MuscleContactsTest, SharesGrowToAllOfTheOverlapInTheLastRound) {
   EXPECT_DOUBLE_EQ(round_share(0.5, 0, 1), 0.5);
   EXPECT_DOUBLE_EQ(round_share(0.5, 0, 2), 0.5);
