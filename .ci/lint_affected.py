@@ -1,8 +1,7 @@
 #!/usr/bin/env python3
 """Which .cpp files clang-tidy must look at, against the lint baseline.
 
-  .ci/lint_affected.py BASELINE          prints the .cpp files to lint, or the
-                                         single line ALL when everything must be
+  .ci/lint_affected.py BASELINE          prints the .cpp files to lint
   .ci/lint_affected.py --record BASELINE writes BASELINE from the current tree
 
 BASELINE lists "<git blob id> <path>" for every tracked .h/.cpp and for the
@@ -10,12 +9,19 @@ files that decide what clang-tidy reports (.clang-tidy, the compile flags), as
 they were when the whole tree last passed `.ci/lint --all`. It needs no git
 history, so a shallow clone reads it as well as a full one.
 
-A file must be linted when its blob differs from the baseline's (or it is new,
-or modified in the working tree), and so must every .cpp that includes such a
-header of ours, directly or through a chain of our headers (includes are
-written from the repository root, e.g. #include "core/mesh/mesh.h").
-Everything must be linted when a settings file changed or the baseline is
-missing."""
+A .cpp must be linted when its blob differs from the baseline's (or it is new,
+or modified in the working tree). A changed header is linted through one
+translation unit that includes it (clang-tidy reports a header's findings from
+any includer, see HeaderFilterRegex): its own .cpp when it has one, otherwise
+the first .cpp that includes it, directly or through a chain of our headers
+(includes are written from the repository root, e.g.
+#include "core/mesh/mesh.h"). So the set grows with what changed, never with
+how widely a header is used: a change to core/errors.h lints one file, not
+every file that includes it.
+
+A changed settings file (.clang-tidy, the compile flags) is reported on
+stderr: it can change findings anywhere, which only `.ci/lint --all`, run by
+hand, checks; CI never lints the whole tree. A missing baseline prints ALL."""
 import os
 import re
 import subprocess
@@ -66,6 +72,37 @@ def read_baseline(baseline):
     return recorded
 
 
+def includers(sources):
+    """path -> set of our headers it includes directly."""
+    found = {}
+    for path in sources:
+        try:
+            with open(path, encoding="utf-8", errors="replace") as f:
+                found[path] = set(INCLUDE.findall(f.read()))
+        except FileNotFoundError:  # deleted in the working tree
+            found[path] = set()
+    return found
+
+
+def translation_unit_for(header, includes):
+    """The .cpp through which clang-tidy sees a changed header, or None."""
+    own = os.path.splitext(header)[0] + ".cpp"
+    if own in includes and header in includes[own] and os.path.exists(own):
+        return own
+    reached = {header}
+    grew = True
+    while grew:  # headers that include the header, directly or through others
+        grew = False
+        for path, included in includes.items():
+            if path.endswith(".h") and path not in reached and included & reached:
+                reached.add(path)
+                grew = True
+    for path in sorted(includes):
+        if path.endswith(".cpp") and includes[path] & reached and os.path.exists(path):
+            return path
+    return None
+
+
 def main():
     if len(sys.argv) == 3 and sys.argv[1] == "--record":
         record(sys.argv[2])
@@ -77,27 +114,22 @@ def main():
     blobs = current_blobs()
     dirty = dirty_paths()
     changed = {p for p, b in blobs.items() if recorded.get(p) != b} | dirty
-    if any(s in changed for s in SETTINGS):
-        print("ALL")
-        return
+    settings = sorted(s for s in SETTINGS if s in changed)
+    if settings:
+        print(f"lint: {', '.join(settings)} changed since the baseline: findings may change in "
+              "files not linted here; run `.ci/lint --all` by hand and commit the baseline it "
+              "records", file=sys.stderr)
     sources = [p for p in blobs if p.endswith((".h", ".cpp"))]
     sources += [p for p in dirty if p.endswith((".h", ".cpp")) and p not in blobs]
-    includes = {}
-    for path in sources:
-        try:
-            with open(path, encoding="utf-8", errors="replace") as f:
-                includes[path] = set(INCLUDE.findall(f.read()))
-        except FileNotFoundError:  # deleted in the working tree
-            includes[path] = set()
-    affected = {p for p in changed if p.endswith((".h", ".cpp"))}
-    grew = True
-    while grew:
-        grew = False
-        for path in sources:
-            if path not in affected and includes[path] & affected:
-                affected.add(path)
-                grew = True
-    for path in sorted(p for p in affected if p.endswith(".cpp") and os.path.exists(p)):
+    includes = includers(sources)
+    affected = {p for p in changed if p.endswith(".cpp") and os.path.exists(p)}
+    for header in sorted(p for p in changed if p.endswith(".h") and os.path.exists(p)):
+        unit = translation_unit_for(header, includes)
+        if unit:
+            affected.add(unit)
+        else:
+            print(f"lint: no .cpp includes {header}; clang-tidy does not see it", file=sys.stderr)
+    for path in sorted(affected):
         print(path)
 
 

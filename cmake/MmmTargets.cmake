@@ -23,12 +23,21 @@ function(mmm_target_settings target)
   endif()
 endfunction()
 
-# mmm_add_library(<name> ALIAS <ns::name> [DEPS <targets>...])
+# mmm_add_library(<name> ALIAS <ns::name> [DEPS <targets>...]
+#                 [SOURCES <files>...] [EXCLUDE <files>...])
 # One static library per top-level folder; sources are the .cpp files below
-# the calling folder (one algorithm per name.h/name.cpp pair).
+# the calling folder (one algorithm per name.h/name.cpp pair), or exactly
+# SOURCES when given; EXCLUDE removes files another library of the folder owns.
 function(mmm_add_library name)
-  cmake_parse_arguments(ARG "" "ALIAS" "DEPS" ${ARGN})
-  file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
+  cmake_parse_arguments(ARG "" "ALIAS" "DEPS;SOURCES;EXCLUDE" ${ARGN})
+  if(ARG_SOURCES)
+    list(TRANSFORM ARG_SOURCES PREPEND ${CMAKE_CURRENT_SOURCE_DIR}/ OUTPUT_VARIABLE sources)
+  else()
+    file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
+  endif()
+  foreach(excluded ${ARG_EXCLUDE})
+    list(REMOVE_ITEM sources ${CMAKE_CURRENT_SOURCE_DIR}/${excluded})
+  endforeach()
   if(NOT sources)
     # A folder whose layer has no code yet is still a target, so that the
     # dependency direction (nodes -> workflow -> core) is fixed from the start.

@@ -38,7 +38,7 @@ void register_report_commands(CLI::App& app, const workflow::NodeRegistry& regis
 // mmm serve: the operator web UI (the registry must outlive the server)
 void register_serve_commands(CLI::App& app, const workflow::NodeRegistry& registry);
 
-// Exit codes of every command (documented in the README).
+// Exit codes of every command (documented in docs/architecture.md, "Exit codes").
 inline constexpr int kExitOk = 0;       // done
 inline constexpr int kExitFailed = 1;   // the command (or a node) failed; message says why
 inline constexpr int kExitUsage = 2;    // the command line is wrong

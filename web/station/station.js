@@ -1,5 +1,5 @@
 // mmm landmark station: the operator's page. Talks to the JSON API of
-// `mmm serve` (README.md: "Operator web UI and its JSON API").
+// `mmm serve` (docs/operators.md: "Operator web UI and its JSON API").
 //
 // Pixel convention (core/image/projection.h): u right, v down; pixel (i, j)
 // covers [i, i+1) x [j, j+1), so the image spans [0, width] x [0, height].

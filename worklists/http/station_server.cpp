@@ -227,13 +227,15 @@ struct StationServer::Impl {
       } catch (const NotFoundError& error) {
         send_error(response, 404, error.what(), "GET /api/worklist lists the open tasks");
       } catch (const BadRequestError& error) {
-        send_error(response, 400, error.what(), "see README.md: Operator web UI and its JSON API");
+        send_error(response, 400, error.what(),
+                   "see docs/operators.md: Operator web UI and its JSON API");
       } catch (const TaskError& error) {
         send_error(response, 409, error.what(), "reload the task: its state may have changed");
       } catch (const InvalidInputError& error) {
-        send_error(response, 400, error.what(), "see README.md: Operator web UI and its JSON API");
+        send_error(response, 400, error.what(),
+                   "see docs/operators.md: Operator web UI and its JSON API");
       } catch (const Json::exception& error) {
-        send_error(response, 400, error.what(), "the body must be JSON as in README.md");
+        send_error(response, 400, error.what(), "the body must be JSON as in docs/operators.md");
       } catch (const std::exception& error) {
         log(request.method + " " + request.path + ": " + error.what());
         send_error(response, 500, error.what(), "the server's log says more");
@@ -411,7 +413,7 @@ struct StationServer::Impl {
     const auto unknown =
         api([](const httplib::Request& request, httplib::Response& response, const std::string&) {
           send_error(response, 404, "no API endpoint " + request.method + " " + request.path,
-                     "see README.md: Operator web UI and its JSON API");
+                     "see docs/operators.md: Operator web UI and its JSON API");
         });
     server.Get("/api/.*", unknown);
     server.Post("/api/.*", unknown);

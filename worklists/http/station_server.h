@@ -2,7 +2,7 @@
 // The operator web UI of the landmark station (`mmm serve`): an HTTP server
 // over the studies of a root folder. It serves the page (static files handed
 // in by the caller, e.g. embedded in the binary) and the JSON API the page
-// uses, documented in README.md ("Operator web UI and its JSON API"):
+// uses, documented in docs/operators.md ("Operator web UI and its JSON API"):
 //
 //   GET  /api/whoami                       the operator of the token
 //   GET  /api/worklist?state=&assignee=&all=1
