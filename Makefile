@@ -72,7 +72,7 @@ bench: build
 format: deps-lint
 	git ls-files '*.h' '*.cpp' | xargs clang-format -i
 
-lint: deps-lint configure
+lint: deps-lint
 	./.ci/lint
 
 clean:

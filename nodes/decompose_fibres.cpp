@@ -26,17 +26,12 @@
 #include "nodes/fibre_picture.h"
 #include "nodes/muscle_selection.h"
 #include "nodes/name_list.h"
+#include "nodes/number_text.h"
 
 namespace mmm::nodes {
 namespace {
 
 using fibres::DecompositionMethod;
-
-std::string fixed(double value, int decimals) {
-  std::vector<char> buffer(64);
-  std::snprintf(buffer.data(), buffer.size(), "%.*f", decimals, value);
-  return buffer.data();
-}
 
 // "muscle=method,..." -> map; names checked against the atlas.
 std::map<std::string, DecompositionMethod> method_overrides(const std::string& text,

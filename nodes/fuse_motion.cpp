@@ -28,7 +28,7 @@ namespace {
 
 constexpr double kDeg = 180.0 / std::numbers::pi;
 
-motion::MotionFusionOptions options_from(const workflow::NodeContext& context) {
+motion::MotionFusionOptions fusion_options_from(const workflow::NodeContext& context) {
   motion::MotionFusionOptions options;
   const double start = context.number("start_time");
   const double end = context.number("end_time");
@@ -236,7 +236,7 @@ workflow::NodeSpec FuseMotion::spec() {
 
 void FuseMotion::run(workflow::NodeContext& context) {
   const auto started = std::chrono::steady_clock::now();
-  const motion::MotionFusionOptions options = options_from(context);
+  const motion::MotionFusionOptions options = fusion_options_from(context);
   context.progress(0, 5, "reading the inputs");
   const opensim::MarkerTrajectories trial =
       opensim::parse_trc(context.input_bytes("trial"), context.input("trial").path);

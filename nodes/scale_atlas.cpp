@@ -16,7 +16,7 @@
 namespace mmm::nodes {
 namespace {
 
-scaling::AtlasScalingOptions options_from(const workflow::NodeContext& context) {
+scaling::AtlasScalingOptions scaling_options_from(const workflow::NodeContext& context) {
   scaling::AtlasScalingOptions options;
   options.landmark_weight = context.number("landmark_weight");
   options.joint_weight = context.number("joint_weight");
@@ -121,7 +121,7 @@ workflow::NodeSpec ScaleAtlas::spec() {
 }
 
 void ScaleAtlas::run(workflow::NodeContext& context) {
-  const scaling::AtlasScalingOptions options = options_from(context);
+  const scaling::AtlasScalingOptions options = scaling_options_from(context);
   context.progress(0, 5, "reading the atlas");
   const std::filesystem::path in = context.scratch_dir() / "atlas_in";
   unpack_directory(context.input_bytes("atlas"), in, "input 'atlas'");

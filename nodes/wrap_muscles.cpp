@@ -17,11 +17,12 @@
 #include "core/wrapping/muscle_wrapping.h"
 #include "core/wrapping/wrapping_summary.h"
 #include "nodes/name_list.h"
+#include "nodes/number_text.h"
 
 namespace mmm::nodes {
 namespace {
 
-wrapping::MuscleWrappingOptions options_from(const workflow::NodeContext& context) {
+wrapping::MuscleWrappingOptions wrapping_options_from(const workflow::NodeContext& context) {
   wrapping::MuscleWrappingOptions options;
   options.target_faces = context.integer("target_faces");
   options.bone_contacts = context.flag("bone_contacts");
@@ -49,12 +50,6 @@ wrapping::MuscleWrappingOptions options_from(const workflow::NodeContext& contex
   options.contacts.tolerance_mm = context.number("contact_tolerance_mm");
   options.contacts.clearance_mm = context.number("contact_clearance_mm");
   return options;
-}
-
-std::string fixed(double value, int decimals) {
-  std::vector<char> buffer(64);
-  std::snprintf(buffer.data(), buffer.size(), "%.*f", decimals, value);
-  return buffer.data();
 }
 
 std::string metrics_csv(const wrapping::MuscleWrapping& wrapped) {
@@ -368,7 +363,7 @@ void WrapMuscles::run(workflow::NodeContext& context) {
         "wrap_muscles: input 'motion' drives an OpenSim model, not an atlas; hint: give "
         "fuse_motion the atlas input (and the model to retarget from)");
   }
-  wrapping::MuscleWrappingOptions options = options_from(context);
+  wrapping::MuscleWrappingOptions options = wrapping_options_from(context);
   if (context.has_input("hulls")) {
     const std::filesystem::path hulls_dir = context.scratch_dir() / "hulls";
     unpack_directory(context.input_bytes("hulls"), hulls_dir, "input 'hulls'");

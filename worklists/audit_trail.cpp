@@ -38,7 +38,7 @@ CREATE TRIGGER IF NOT EXISTS audit_no_delete BEFORE DELETE ON audit
 BEGIN SELECT RAISE(ABORT, 'the audit trail is append-only: entries cannot be deleted'); END;
 )sql";
 
-constexpr const char* kColumns =
+constexpr const char* kAuditColumns =
     "seq, time, operator_name, task_id, action, before_json, after_json, reason, mmm_version, "
     "images_json, prev_hash, hash";
 
@@ -162,7 +162,7 @@ void open_audit_trail(Database& database, const std::filesystem::path& study_dir
 
 void insert_audit_row(Database& database, const AuditRow& row) {
   database
-      .prepare(std::string("INSERT INTO audit(") + kColumns +
+      .prepare(std::string("INSERT INTO audit(") + kAuditColumns +
                ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
       .bind_int64(1, row.seq)
       .bind_text(2, row.time)
@@ -266,7 +266,7 @@ void write_audit_checkpoint(const std::filesystem::path& study_dir, Database& da
 std::vector<AuditRow> read_audit_rows(Database& database) {
   std::vector<AuditRow> rows;
   Statement select =
-      database.prepare(std::string("SELECT ") + kColumns + " FROM audit ORDER BY seq");
+      database.prepare(std::string("SELECT ") + kAuditColumns + " FROM audit ORDER BY seq");
   while (select.step()) rows.push_back(row_of(select));
   return rows;
 }

@@ -12,7 +12,7 @@ using workflow::Database;
 using workflow::Statement;
 using Json = nlohmann::json;
 
-constexpr const char* kColumns =
+constexpr const char* kTaskColumns =
     "id, node, node_type, cache_key, key_json, state, assignee, created_at, updated_at, "
     "request_json, submission_json, result_json, rejection_json, result_execution, revision";
 
@@ -61,8 +61,8 @@ void bind_fields(Statement& statement, const Task& task) {
 
 std::vector<Task> select_tasks(Database& database, const std::string& where,
                                const std::string& value) {
-  Statement select = database.prepare(std::string("SELECT ") + kColumns + " FROM tasks" + where +
-                                      " ORDER BY created_at, id");
+  Statement select = database.prepare(std::string("SELECT ") + kTaskColumns + " FROM tasks" +
+                                      where + " ORDER BY created_at, id");
   if (!where.empty()) select.bind_text(1, value);
   std::vector<Task> tasks;
   while (select.step()) tasks.push_back(read_row(select));
@@ -106,7 +106,7 @@ void insert_task(Database& database, const Task& task) {
     throw InvalidInputError("task id " + task.id + " is already used in " +
                             database.path().string());
   }
-  Statement insert = database.prepare(std::string("INSERT INTO tasks(") + kColumns +
+  Statement insert = database.prepare(std::string("INSERT INTO tasks(") + kTaskColumns +
                                       ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   insert.bind_text(1, task.id);
   bind_fields(insert, task);

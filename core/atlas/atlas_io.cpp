@@ -639,7 +639,7 @@ struct FaceCheck {
   std::string path;
 };
 
-class Reader {
+class AtlasReader {
  public:
   void report(const YAML::Mark& mark, const std::string& path, const std::string& message) {
     problems_.push_back({mark.line, mark.column, path.empty() ? "top level" : path, message});
@@ -722,7 +722,7 @@ enum class Need { kOptional, kRequired };
 
 // Scalar conversions; each reports its own problem and returns nullopt.
 
-std::optional<std::string> read_text(Reader& r, const Value& v) {
+std::optional<std::string> read_text(AtlasReader& r, const Value& v) {
   if (!v.node.IsScalar()) {
     r.report(v, "expected a string, got " + describe(v.node));
     return std::nullopt;
@@ -730,7 +730,7 @@ std::optional<std::string> read_text(Reader& r, const Value& v) {
   return v.node.Scalar();
 }
 
-std::optional<std::string> read_name(Reader& r, const Value& v) {
+std::optional<std::string> read_name(AtlasReader& r, const Value& v) {
   std::optional<std::string> name = read_text(r, v);
   if (name && name->empty()) {
     r.report(v, "must not be empty");
@@ -739,7 +739,7 @@ std::optional<std::string> read_name(Reader& r, const Value& v) {
   return name;
 }
 
-std::optional<double> read_number(Reader& r, const Value& v) {
+std::optional<double> read_number(AtlasReader& r, const Value& v) {
   double value = 0.0;
   // A quoted scalar is a string, whatever it looks like (YAML 1.2).
   const bool plain = v.node.IsScalar() && v.node.Tag() != "!";
@@ -754,7 +754,7 @@ std::optional<double> read_number(Reader& r, const Value& v) {
   return std::nullopt;
 }
 
-std::optional<int> read_integer(Reader& r, const Value& v) {
+std::optional<int> read_integer(AtlasReader& r, const Value& v) {
   long long value = 0;
   if (v.node.IsScalar() && v.node.Tag() != "!" && parse_integer(v.node.Scalar(), value)) {
     if (value >= std::numeric_limits<int>::min() && value <= std::numeric_limits<int>::max()) {
@@ -767,7 +767,7 @@ std::optional<int> read_integer(Reader& r, const Value& v) {
   return std::nullopt;
 }
 
-std::optional<bool> read_boolean(Reader& r, const Value& v) {
+std::optional<bool> read_boolean(AtlasReader& r, const Value& v) {
   if (v.node.IsScalar() && v.node.Tag() != "!") {
     const std::string& text = v.node.Scalar();
     if (text == "true" || text == "True" || text == "TRUE") return true;
@@ -778,7 +778,7 @@ std::optional<bool> read_boolean(Reader& r, const Value& v) {
 }
 
 // The items of a list value, each with its position and path.
-std::optional<std::vector<Value>> read_items(Reader& r, const Value& v) {
+std::optional<std::vector<Value>> read_items(AtlasReader& r, const Value& v) {
   if (!v.node.IsSequence()) {
     r.report(v, "expected a list, got " + describe(v.node));
     return std::nullopt;
@@ -793,7 +793,7 @@ std::optional<std::vector<Value>> read_items(Reader& r, const Value& v) {
   return items;
 }
 
-std::optional<std::vector<double>> read_numbers(Reader& r, const Value& v,
+std::optional<std::vector<double>> read_numbers(AtlasReader& r, const Value& v,
                                                 std::optional<std::size_t> count = {}) {
   const std::optional<std::vector<Value>> items = read_items(r, v);
   if (!items) return std::nullopt;
@@ -812,13 +812,13 @@ std::optional<std::vector<double>> read_numbers(Reader& r, const Value& v,
   return ok ? std::optional(values) : std::nullopt;
 }
 
-std::optional<Eigen::Vector3d> read_vector3(Reader& r, const Value& v) {
+std::optional<Eigen::Vector3d> read_vector3(AtlasReader& r, const Value& v) {
   const std::optional<std::vector<double>> values = read_numbers(r, v, 3);
   if (!values) return std::nullopt;
   return Eigen::Vector3d((*values)[0], (*values)[1], (*values)[2]);
 }
 
-std::optional<std::array<double, 2>> read_range(Reader& r, const Value& v) {
+std::optional<std::array<double, 2>> read_range(AtlasReader& r, const Value& v) {
   const std::optional<std::vector<double>> values = read_numbers(r, v, 2);
   if (!values) return std::nullopt;
   if ((*values)[0] > (*values)[1]) {
@@ -829,7 +829,7 @@ std::optional<std::array<double, 2>> read_range(Reader& r, const Value& v) {
   return std::array<double, 2>{(*values)[0], (*values)[1]};
 }
 
-std::optional<std::vector<std::string>> read_texts(Reader& r, const Value& v) {
+std::optional<std::vector<std::string>> read_texts(AtlasReader& r, const Value& v) {
   const std::optional<std::vector<Value>> items = read_items(r, v);
   if (!items) return std::nullopt;
   std::vector<std::string> values;
@@ -844,7 +844,7 @@ std::optional<std::vector<std::string>> read_texts(Reader& r, const Value& v) {
 // key must not be silently ignored).
 class MapReader {
  public:
-  MapReader(Reader& r, const Value& v) : reader_(r), value_(v) {
+  MapReader(AtlasReader& r, const Value& v) : reader_(r), value_(v) {
     if (!v.node.IsMap()) {
       r.report(v, "expected a mapping, got " + describe(v.node));
       return;
@@ -976,7 +976,7 @@ class MapReader {
     return v;
   }
 
-  Reader& reader_;
+  AtlasReader& reader_;
   Value value_;
   bool valid_ = false;
   std::map<std::string, Entry> entries_;
@@ -985,8 +985,8 @@ class MapReader {
 
 // Calls read_item for each item of the list at `key` (absent: nothing).
 template <class T, class ReadItem>
-void read_list(Reader& r, MapReader& m, const std::string& key, std::vector<T>& target, Need need,
-               ReadItem read_item) {
+void read_list(AtlasReader& r, MapReader& m, const std::string& key, std::vector<T>& target,
+               Need need, ReadItem read_item) {
   const std::optional<Value> v = m.get(key, need);
   if (!v) return;
   const std::optional<std::vector<Value>> items = read_items(r, *v);
@@ -997,7 +997,7 @@ void read_list(Reader& r, MapReader& m, const std::string& key, std::vector<T>& 
 // {origin: [x, y, z], rotation: [[r00, r01, r02], [...], [...]]}, rows of the
 // rotation; the rotation must be orthonormal within 1e-6 and proper. It is
 // kept as written (not re-orthonormalised), so write -> read is exact.
-std::optional<Eigen::Isometry3d> read_frame(Reader& r, const Value& v) {
+std::optional<Eigen::Isometry3d> read_frame(AtlasReader& r, const Value& v) {
   MapReader m(r, v);
   if (!m.valid()) return std::nullopt;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -1046,7 +1046,7 @@ std::optional<Eigen::Isometry3d> read_frame(Reader& r, const Value& v) {
   return ok ? std::optional(pose) : std::nullopt;
 }
 
-std::optional<opensim::Function> read_function(Reader& r, const Value& v) {
+std::optional<opensim::Function> read_function(AtlasReader& r, const Value& v) {
   MapReader m(r, v);
   if (!m.valid()) return std::nullopt;
   const std::optional<std::size_t> kind =
@@ -1098,7 +1098,7 @@ std::optional<opensim::Function> read_function(Reader& r, const Value& v) {
 }
 
 // [{level, file, faces}, ...]
-std::vector<MeshLevel> read_mesh_levels(Reader& r, MapReader& element) {
+std::vector<MeshLevel> read_mesh_levels(AtlasReader& r, MapReader& element) {
   std::vector<MeshLevel> levels;
   read_list(r, element, "meshes", levels, Need::kOptional, [&](const Value& item) {
     MeshLevel level;
@@ -1125,21 +1125,22 @@ std::vector<MeshLevel> read_mesh_levels(Reader& r, MapReader& element) {
 }
 
 // Reads `key` as a frame into `target` (identity when absent).
-void read_frame_field(Reader& r, MapReader& m, const std::string& key, Eigen::Isometry3d& target) {
+void read_frame_field(AtlasReader& r, MapReader& m, const std::string& key,
+                      Eigen::Isometry3d& target) {
   if (const std::optional<Value> v = m.get(key, Need::kOptional)) {
     if (std::optional<Eigen::Isometry3d> pose = read_frame(r, *v)) target = *pose;
   }
 }
 
 // A name that refers to an element of another kind.
-void refer(Reader& r, MapReader& m, const std::string& key, std::string& target, RefKind kind,
+void refer(AtlasReader& r, MapReader& m, const std::string& key, std::string& target, RefKind kind,
            Need need) {
   if (const std::optional<Value> v = m.name(key, target, need)) r.refer(kind, target, *v);
 }
 
 // A list of names that refer to elements of another kind.
-void refer_all(Reader& r, MapReader& m, const std::string& key, std::vector<std::string>& target,
-               RefKind kind) {
+void refer_all(AtlasReader& r, MapReader& m, const std::string& key,
+               std::vector<std::string>& target, RefKind kind) {
   const std::optional<Value> v = m.get(key, Need::kOptional);
   if (!v) return;
   const std::optional<std::vector<Value>> items = read_items(r, *v);
@@ -1152,7 +1153,7 @@ void refer_all(Reader& r, MapReader& m, const std::string& key, std::vector<std:
   }
 }
 
-Region read_region(Reader& r, const Value& v) {
+Region read_region(AtlasReader& r, const Value& v) {
   Region region;
   MapReader m(r, v);
   if (!m.valid()) return region;
@@ -1166,7 +1167,7 @@ Region read_region(Reader& r, const Value& v) {
   return region;
 }
 
-Bone read_bone(Reader& r, const Value& v) {
+Bone read_bone(AtlasReader& r, const Value& v) {
   Bone bone;
   MapReader m(r, v);
   if (!m.valid()) return bone;
@@ -1181,7 +1182,7 @@ Bone read_bone(Reader& r, const Value& v) {
   return bone;
 }
 
-Coordinate read_coordinate(Reader& r, const Value& v) {
+Coordinate read_coordinate(AtlasReader& r, const Value& v) {
   Coordinate coordinate;
   MapReader m(r, v);
   if (!m.valid()) return coordinate;
@@ -1200,7 +1201,7 @@ Coordinate read_coordinate(Reader& r, const Value& v) {
   return coordinate;
 }
 
-TransformAxis read_axis(Reader& r, const Value& v, const Joint& joint) {
+TransformAxis read_axis(AtlasReader& r, const Value& v, const Joint& joint) {
   TransformAxis axis;
   MapReader m(r, v);
   if (!m.valid()) return axis;
@@ -1227,7 +1228,7 @@ TransformAxis read_axis(Reader& r, const Value& v, const Joint& joint) {
   return axis;
 }
 
-Joint read_joint(Reader& r, const Value& v) {
+Joint read_joint(AtlasReader& r, const Value& v) {
   Joint joint;
   MapReader m(r, v);
   if (!m.valid()) return joint;
@@ -1287,7 +1288,7 @@ Joint read_joint(Reader& r, const Value& v) {
   return joint;
 }
 
-PathPoint read_point(Reader& r, const Value& v) {
+PathPoint read_point(AtlasReader& r, const Value& v) {
   PathPoint point;
   MapReader m(r, v);
   if (!m.valid()) return point;
@@ -1331,7 +1332,7 @@ PathPoint read_point(Reader& r, const Value& v) {
   return point;
 }
 
-ActionLine read_action_line(Reader& r, const Value& v, const Muscle& muscle) {
+ActionLine read_action_line(AtlasReader& r, const Value& v, const Muscle& muscle) {
   ActionLine line;
   MapReader m(r, v);
   if (!m.valid()) return line;
@@ -1366,7 +1367,7 @@ ActionLine read_action_line(Reader& r, const Value& v, const Muscle& muscle) {
   return line;
 }
 
-AttachmentArea read_area(Reader& r, const Value& v) {
+AttachmentArea read_area(AtlasReader& r, const Value& v) {
   AttachmentArea area;
   MapReader m(r, v);
   if (!m.valid()) return area;
@@ -1403,7 +1404,7 @@ AttachmentArea read_area(Reader& r, const Value& v) {
   return area;
 }
 
-WrapObstacle read_wrap_obstacle(Reader& r, const Value& v, const std::string& scope) {
+WrapObstacle read_wrap_obstacle(AtlasReader& r, const Value& v, const std::string& scope) {
   WrapObstacle obstacle;
   MapReader m(r, v);
   if (!m.valid()) return obstacle;
@@ -1439,7 +1440,7 @@ WrapObstacle read_wrap_obstacle(Reader& r, const Value& v, const std::string& sc
   return obstacle;
 }
 
-Muscle read_muscle(Reader& r, const Value& v) {
+Muscle read_muscle(AtlasReader& r, const Value& v) {
   Muscle muscle;
   MapReader m(r, v);
   if (!m.valid()) return muscle;
@@ -1477,7 +1478,7 @@ Muscle read_muscle(Reader& r, const Value& v) {
   return muscle;
 }
 
-Landmark read_landmark(Reader& r, const Value& v) {
+Landmark read_landmark(AtlasReader& r, const Value& v) {
   Landmark landmark;
   MapReader m(r, v);
   if (!m.valid()) return landmark;
@@ -1492,7 +1493,7 @@ Landmark read_landmark(Reader& r, const Value& v) {
   return landmark;
 }
 
-Marker read_marker(Reader& r, const Value& v) {
+Marker read_marker(AtlasReader& r, const Value& v) {
   Marker marker;
   MapReader m(r, v);
   if (!m.valid()) return marker;
@@ -1508,7 +1509,7 @@ Marker read_marker(Reader& r, const Value& v) {
 
 // Parent joints and joint children must agree: bone B names joint J as its
 // parent_joint exactly when J's child is B.
-void check_tree(Reader& r, const Atlas& atlas, const std::vector<Value>& bone_items,
+void check_tree(AtlasReader& r, const Atlas& atlas, const std::vector<Value>& bone_items,
                 const std::vector<Value>& joint_items) {
   for (std::size_t i = 0; i < atlas.bones.size() && i < bone_items.size(); ++i) {
     const Bone& bone = atlas.bones[i];
@@ -1535,7 +1536,7 @@ void check_tree(Reader& r, const Atlas& atlas, const std::vector<Value>& bone_it
 
 // Reads the manifest text into `atlas`; returns the problems (empty: valid).
 std::vector<Problem> parse_manifest(const std::string& text, Atlas& atlas) {
-  Reader r;
+  AtlasReader r;
   YAML::Node root;
   try {
     const std::vector<YAML::Node> documents = YAML::LoadAll(text);

@@ -13,9 +13,9 @@ namespace mmm::atlas {
 namespace {
 
 // Reading context: the file and the path of the current field, for messages.
-class Reader {
+class RecipeReader {
  public:
-  explicit Reader(std::filesystem::path file) : file_(std::move(file)) {}
+  explicit RecipeReader(std::filesystem::path file) : file_(std::move(file)) {}
 
   [[noreturn]] void fail(const YAML::Node& node, const std::string& field,
                          const std::string& problem) const {
@@ -134,7 +134,7 @@ class Reader {
 };
 
 template <class T>
-void check_unique(const Reader& reader, const YAML::Node& root, const std::string& key,
+void check_unique(const RecipeReader& reader, const YAML::Node& root, const std::string& key,
                   const std::vector<T>& items) {
   std::set<std::string> seen;
   for (std::size_t i = 0; i < items.size(); ++i) {
@@ -157,7 +157,7 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
     throw IoError(file,
                   "line " + std::to_string(error.mark.line + 1) + ": malformed YAML: " + error.msg);
   }
-  const Reader reader(file);
+  const RecipeReader reader(file);
   if (!root.IsMap()) reader.fail(root, "(top)", "expects a mapping holding mmm_atlas_recipe: 1");
   reader.check_keys(
       root, "(top)",

@@ -23,7 +23,7 @@ const Eigen::Affine3d& body_map(const BodyMaps& maps, const std::string& body,
   return it->second;
 }
 
-opensim::Function scaled(const opensim::Function& function, double scale) {
+opensim::Function scaled_to_mm(const opensim::Function& function, double scale) {
   return {opensim::MultiplierFunction(function, scale)};
 }
 
@@ -117,7 +117,8 @@ MappedJoint map_joint(const opensim::Joint& source, const BodyMaps& maps) {
     mapped_axis.rotation = axis.name.starts_with("rotation");
     mapped_axis.axis = axis.axis;
     mapped_axis.coordinate = axis.coordinates.empty() ? "" : axis.coordinates.front();
-    mapped_axis.function = mapped_axis.rotation ? axis.function : scaled(axis.function, scale);
+    mapped_axis.function =
+        mapped_axis.rotation ? axis.function : scaled_to_mm(axis.function, scale);
     joint.axes.push_back(std::move(mapped_axis));
   }
   if (joint.type == JointType::kWeld || source.coordinates.empty()) return mapped;
@@ -183,8 +184,9 @@ ActionLine map_action_line(const opensim::OsimModel& model, const opensim::Muscl
       point.kind = PathPointKind::kMoving;
       point.moving_coordinates = {source.x_coordinate, source.y_coordinate, source.z_coordinate};
       const double scale = maps.scale(body);
-      point.moving_functions = {scaled(source.x_location, scale), scaled(source.y_location, scale),
-                                scaled(source.z_location, scale)};
+      point.moving_functions = {scaled_to_mm(source.x_location, scale),
+                                scaled_to_mm(source.y_location, scale),
+                                scaled_to_mm(source.z_location, scale)};
       local = opensim::frame_in_body(source.frame) *
               Eigen::Vector3d(source.x_location.evaluate(rest_of(source.x_coordinate)),
                               source.y_location.evaluate(rest_of(source.y_coordinate)),

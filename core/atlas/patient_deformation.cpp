@@ -32,7 +32,7 @@ double length_scale(const Eigen::Affine3d& map) {
   return std::cbrt(std::abs(map.linear().determinant()));
 }
 
-opensim::Function scaled(const opensim::Function& function, double factor) {
+opensim::Function length_scaled(const opensim::Function& function, double factor) {
   return opensim::MultiplierFunction(function, factor);
 }
 
@@ -167,7 +167,7 @@ Atlas deform_atlas(const Atlas& atlas, const PatientDeformation& deformation) {
     joint.parent_frame = frame_on(joint.parent, joint.parent_frame);
     joint.child_frame = frame_on(joint.child, joint.child_frame);
     for (TransformAxis& axis : joint.axes) {
-      if (!axis.rotation) axis.function = scaled(axis.function, length_scale(parent));
+      if (!axis.rotation) axis.function = length_scaled(axis.function, length_scale(parent));
     }
   }
   for (Muscle& muscle : patient.muscles) {
@@ -177,7 +177,7 @@ Atlas deform_atlas(const Atlas& atlas, const PatientDeformation& deformation) {
         point.position = deformation.map_on_bone(point.bone, point.position);
         if (point.kind == PathPointKind::kMoving) {
           for (opensim::Function& function : point.moving_functions) {
-            function = scaled(function, length_scale(map));
+            function = length_scaled(function, length_scale(map));
           }
         }
       }

@@ -10,7 +10,7 @@
 namespace mmm::fibres {
 namespace {
 
-void check_points(const std::vector<double>& x, const std::vector<double>& y) {
+void check_spline_points(const std::vector<double>& x, const std::vector<double>& y) {
   if (x.size() != y.size()) {
     throw InvalidInputError("constrained spline: " + std::to_string(x.size()) + " x values but " +
                             std::to_string(y.size()) + " y values; expected one y per x");
@@ -37,7 +37,7 @@ void check_points(const std::vector<double>& x, const std::vector<double>& y) {
 
 ConstrainedSpline::ConstrainedSpline(std::vector<double> x, std::vector<double> y)
     : x_(std::move(x)), y_(std::move(y)) {
-  check_points(x_, y_);
+  check_spline_points(x_, y_);
   const std::size_t n = x_.size();
   std::vector<double> secant(n - 1);
   for (std::size_t i = 0; i + 1 < n; ++i) secant[i] = (y_[i + 1] - y_[i]) / (x_[i + 1] - x_[i]);

@@ -45,7 +45,7 @@ std::vector<int> patch(const Eigen::VectorXd& excess, double margin,
   return chosen;
 }
 
-void check_points(const Eigen::MatrixX3d& points, const char* which) {
+void check_attachment_area(const Eigen::MatrixX3d& points, const char* which) {
   if (points.rows() == 0 || !points.allFinite()) {
     throw InvalidInputError(std::string("end patches: the ") + which +
                             " area has no points or a point that is not finite; the muscle "
@@ -57,8 +57,8 @@ void check_points(const Eigen::MatrixX3d& points, const char* which) {
 
 EndPatches end_patches(const mesh::IndexedMesh& surface, const Attachments& areas,
                        double margin_mm) {
-  check_points(areas.origin, "origin");
-  check_points(areas.insertion, "insertion");
+  check_attachment_area(areas.origin, "origin");
+  check_attachment_area(areas.insertion, "insertion");
   if (!(margin_mm >= 0.0) || !std::isfinite(margin_mm)) {
     throw InvalidInputError("end patches: margin " + std::to_string(margin_mm) +
                             " mm; use a finite margin >= 0 (3 mm)");

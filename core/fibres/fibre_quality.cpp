@@ -38,7 +38,7 @@ void check_options(const FibreQualityOptions& options) {
   }
 }
 
-void check_points(const Eigen::MatrixX3d& points, const std::string& name) {
+void check_attachment_points(const Eigen::MatrixX3d& points, const std::string& name) {
   if (points.rows() == 0) {
     throw InvalidInputError(std::string(kWhat) + "no " + name +
                             " points; hint: sample at least one point on the " + name +
@@ -205,8 +205,8 @@ FibreQuality measure_fibre_quality(const mesh::IndexedMesh& surface,
   std::vector<double> lengths;
   lengths.reserve(fibres.size());
   for (std::size_t i = 0; i < fibres.size(); ++i) lengths.push_back(checked_length(fibres[i], i));
-  check_points(origin, "origin");
-  check_points(insertion, "insertion");
+  check_attachment_points(origin, "origin");
+  check_attachment_points(insertion, "insertion");
   if (surface.empty())
     throw InvalidInputError(std::string(kWhat) + "the muscle surface has no face");
 

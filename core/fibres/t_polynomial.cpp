@@ -11,7 +11,7 @@
 namespace mmm::fibres {
 namespace {
 
-void check_points(const Eigen::MatrixXd& points, const std::string& what) {
+void check_polynomial_points(const Eigen::MatrixXd& points, const std::string& what) {
   if (points.cols() < 3) {
     throw InvalidInputError(what + ": points need x y z columns (3, or 4 with a radius), got " +
                             std::to_string(points.cols()));
@@ -37,7 +37,7 @@ Eigen::MatrixXd vandermonde(const Eigen::VectorXd& t, int degree) {
 }  // namespace
 
 Eigen::VectorXd arc_length_parameters(const Eigen::MatrixXd& points) {
-  check_points(points, "t-polynomial");
+  check_polynomial_points(points, "t-polynomial");
   if (points.rows() < 2) throw InvalidInputError("t-polynomial: a path needs at least two points");
   Eigen::VectorXd t(points.rows());
   t[0] = 0.0;
@@ -99,7 +99,7 @@ TPolynomialFit fit_t_polynomial(const Eigen::VectorXd& t, const Eigen::MatrixXd&
                             " is out of range 0.." + std::to_string(kMaxTPolynomialDegree) +
                             "; hint: 3 or 4 suffice for muscle fibres (the reference document)");
   }
-  check_points(points, "t-polynomial");
+  check_polynomial_points(points, "t-polynomial");
   if (t.size() != points.rows()) {
     throw InvalidInputError("t-polynomial: " + std::to_string(t.size()) + " values of t for " +
                             std::to_string(points.rows()) + " points");

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "core/fit/lm_damping.h"
 #include "core/fit/principal_axes.h"
 
 namespace mmm::fit {
@@ -25,10 +26,9 @@ constexpr double kRankRatio = 1e-12;
 // Orthonormality tolerance of caller-given scale axes (|A^T A - I|, max entry).
 constexpr double kOrthonormalTolerance = 1e-9;
 
-// Levenberg-Marquardt damping (see sphere_fit.cpp).
-constexpr double kInitialDamping = 1e-4;
-constexpr double kMinDamping = 1e-12;
-constexpr double kMaxDamping = 1e12;
+using detail::kInitialDamping;
+using detail::kMaxDamping;
+using detail::kMinDamping;
 
 // The weighted pairs, centred on their weighted centroids; weights sum to 1.
 struct Centred {

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "core/fit/lm_damping.h"
 
 namespace mmm::fit {
 namespace {
@@ -19,11 +20,9 @@ namespace {
 // times its width.)
 constexpr double kCoplanarVarianceRatio = 1e-12;
 
-// Levenberg-Marquardt damping: initial value, and the bounds beyond which the
-// step is either plain Gauss-Newton or too short to matter.
-constexpr double kInitialDamping = 1e-4;
-constexpr double kMinDamping = 1e-12;
-constexpr double kMaxDamping = 1e12;
+using detail::kInitialDamping;
+using detail::kMaxDamping;
+using detail::kMinDamping;
 
 // The points in normalised coordinates q = (p - mean) / spread.
 struct Normalised {

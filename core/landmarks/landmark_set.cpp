@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "core/errors.h"
+#include "core/landmarks/message_text.h"
 
 namespace mmm::landmarks {
 
@@ -18,24 +19,13 @@ namespace {
 constexpr const char* kFormat = "mmm-landmark-set";
 constexpr int kVersion = 1;
 
-// The parts one after the other (one allocation, for messages built in loops).
-std::string concat(std::initializer_list<std::string_view> parts) {
-  std::string out;
-  for (const std::string_view part : parts) out += part;
-  return out;
-}
+using detail::concat;
+using detail::describe_json;
 
 std::string landmark_label(std::size_t index, std::string_view name) {
   std::string label = "landmarks[" + std::to_string(index) + "]";
   if (!name.empty()) label += " ('" + std::string(name) + "')";
   return label;
-}
-
-// A short rendering of a JSON value for messages (long values cut).
-std::string describe(const Json& value) {
-  std::string text = value.dump();
-  if (text.size() > 60) text = text.substr(0, 57) + "...";
-  return text;
 }
 
 // Reads and checks one JSON document; every failure names `what` and the field.
@@ -56,7 +46,7 @@ class Reader {
   std::string text_field(const Json& object, const std::string& where, const char* key) const {
     const Json& value = field(object, where, key);
     if (!value.is_string()) {
-      fail(where, std::string("field '") + key + "' must be a string, got " + describe(value));
+      fail(where, std::string("field '") + key + "' must be a string, got " + describe_json(value));
     }
     return value.get<std::string>();
   }
@@ -66,7 +56,7 @@ class Reader {
                                      const std::string& field_name) const {
     const auto bad = [&] {
       fail(where, "field '" + field_name + "' must be " + std::to_string(N) +
-                      " finite numbers, got " + describe(value));
+                      " finite numbers, got " + describe_json(value));
     };
     if (!value.is_array() || value.size() != static_cast<std::size_t>(N)) bad();
     Eigen::Matrix<double, N, 1> out;
@@ -81,7 +71,7 @@ class Reader {
 
   Landmark landmark(const Json& entry, std::size_t index) const {
     std::string where = landmark_label(index, "");
-    if (!entry.is_object()) fail(where, "must be a JSON object, got " + describe(entry));
+    if (!entry.is_object()) fail(where, "must be a JSON object, got " + describe_json(entry));
     Landmark landmark;
     landmark.name = text_field(entry, where, "name");
     if (landmark.name.empty()) fail(where, "field 'name' is empty");
@@ -89,7 +79,7 @@ class Reader {
     landmark.position_mm = vector<3>(field(entry, where, "position_mm"), where, "position_mm");
     if (const auto pixels = entry.find("pixels"); pixels != entry.end()) {
       if (!pixels->is_object()) {
-        fail(where, "field 'pixels' must map view names to [u, v], got " + describe(*pixels));
+        fail(where, "field 'pixels' must map view names to [u, v], got " + describe_json(*pixels));
       }
       for (const auto& [view, pixel] : pixels->items()) {
         if (view.empty()) fail(where, "field 'pixels' has an empty view name");
@@ -98,14 +88,14 @@ class Reader {
     }
     if (const auto errors = entry.find("reprojection_error_mm"); errors != entry.end()) {
       if (!errors->is_object()) {
-        fail(where,
-             "field 'reprojection_error_mm' must map view names to mm, got " + describe(*errors));
+        fail(where, "field 'reprojection_error_mm' must map view names to mm, got " +
+                        describe_json(*errors));
       }
       for (const auto& [view, error] : errors->items()) {
         if (view.empty()) fail(where, "field 'reprojection_error_mm' has an empty view name");
         if (!error.is_number() || !std::isfinite(error.get<double>()) || error.get<double>() < 0) {
           fail(where, "field 'reprojection_error_mm." + view +
-                          "' must be a finite number >= 0, got " + describe(error));
+                          "' must be a finite number >= 0, got " + describe_json(error));
         }
         landmark.reprojection_error_mm[view] = error.get<double>();
       }
@@ -114,22 +104,24 @@ class Reader {
   }
 
   LandmarkSet set(const Json& root) const {
-    if (!root.is_object()) fail("", "must be a JSON object, got " + describe(root));
+    if (!root.is_object()) fail("", "must be a JSON object, got " + describe_json(root));
     const Json& format = field(root, "", "format");
     if (!format.is_string() || format.get<std::string>() != kFormat) {
-      fail("", std::string("field 'format' must be \"") + kFormat + "\", got " + describe(format));
+      fail("",
+           std::string("field 'format' must be \"") + kFormat + "\", got " + describe_json(format));
     }
     const Json& version = field(root, "", "version");
     if (!version.is_number_integer() || version.get<std::int64_t>() != kVersion) {
       fail("", "field 'version' must be " + std::to_string(kVersion) + ", got " +
-                   describe(version) + " (written by a newer mmm?)");
+                   describe_json(version) + " (written by a newer mmm?)");
     }
     LandmarkSet set;
     set.frame = text_field(root, "", "frame");
     if (set.frame.empty()) fail("", R"(field 'frame' is empty; hint: "patient" or "lab")");
     set.source = text_field(root, "", "source");
     const Json& list = field(root, "", "landmarks");
-    if (!list.is_array()) fail("", "field 'landmarks' must be an array, got " + describe(list));
+    if (!list.is_array())
+      fail("", "field 'landmarks' must be an array, got " + describe_json(list));
     std::map<std::string, std::size_t> first_index;
     for (std::size_t i = 0; i < list.size(); ++i) {
       set.landmarks.push_back(landmark(list[i], i));
@@ -153,6 +145,12 @@ Json vector_json(const auto& v) {
 }
 
 }  // namespace
+
+std::string detail::describe_json(const Json& value) {
+  std::string text = value.dump();
+  if (text.size() > 60) text = text.substr(0, 57) + "...";
+  return text;
+}
 
 const Landmark* LandmarkSet::find(std::string_view name) const {
   for (const Landmark& landmark : landmarks) {

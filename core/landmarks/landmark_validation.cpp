@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "core/errors.h"
+#include "core/landmarks/message_text.h"
 #include "core/suggest.h"
 
 namespace mmm::landmarks {
@@ -22,12 +23,7 @@ std::string mm(double value) {
   return buffer.data();
 }
 
-// The parts one after the other (one allocation, for messages built in loops).
-std::string concat(std::initializer_list<std::string_view> parts) {
-  std::string out;
-  for (const std::string_view part : parts) out += part;
-  return out;
-}
+using detail::concat;
 
 std::string pixel_text(const Eigen::Vector2d& pixel) {
   return "(" + mm(pixel.x()) + ", " + mm(pixel.y()) + ")";

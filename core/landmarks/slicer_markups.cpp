@@ -7,6 +7,7 @@
 
 #include "core/errors.h"
 #include "core/file_bytes.h"
+#include "core/landmarks/message_text.h"
 
 namespace mmm::landmarks {
 
@@ -19,11 +20,7 @@ constexpr const char* kSchema =
     "https://raw.githubusercontent.com/slicer/slicer/master/Modules/Loadable/Markups/Resources/"
     "Schema/markups-schema-v1.0.3.json#";
 
-std::string describe(const Json& value) {
-  std::string text = value.dump();
-  if (text.size() > 60) text = text.substr(0, 57) + "...";
-  return text;
-}
+using detail::describe_json;
 
 std::string normalise(std::string_view label) {
   std::string out;
@@ -66,7 +63,7 @@ class MarkupsReader {
     } catch (const Json::parse_error& error) {
       fail("", std::string("not valid JSON: ") + error.what());
     }
-    if (!root.is_object()) fail("", "must hold a JSON object, got " + describe(root));
+    if (!root.is_object()) fail("", "must hold a JSON object, got " + describe_json(root));
     const auto markups = root.find("markups");
     if (markups == root.end() || !markups->is_array()) {
       fail("", "field 'markups' must be an array; hint: is this a Slicer .mrk.json file?");
@@ -89,7 +86,7 @@ class MarkupsReader {
  private:
   // Reads markups[m]; false when it is not a point list.
   bool markup(const Json& entry, const std::string& where) {
-    if (!entry.is_object()) fail(where, "must be a JSON object, got " + describe(entry));
+    if (!entry.is_object()) fail(where, "must be a JSON object, got " + describe_json(entry));
     const auto type = entry.find("type");
     if (type == entry.end() || !type->is_string()) {
       fail(where, "field 'type' must be a string, e.g. \"Fiducial\"");
@@ -103,7 +100,7 @@ class MarkupsReader {
     std::string system = "LPS";
     if (const auto it = entry.find("coordinateSystem"); it != entry.end()) {
       if (!it->is_string() || (*it != "LPS" && *it != "RAS")) {
-        fail(where + ".coordinateSystem", R"(must be "LPS" or "RAS", got )" + describe(*it));
+        fail(where + ".coordinateSystem", R"(must be "LPS" or "RAS", got )" + describe_json(*it));
       }
       system = it->get<std::string>();
     }
@@ -117,7 +114,7 @@ class MarkupsReader {
       } else if (units == "m") {
         scale = 1e3;
       } else {
-        fail(where + ".coordinateUnits", R"(must be "mm", "um" or "m", got )" + describe(*it));
+        fail(where + ".coordinateUnits", R"(must be "mm", "um" or "m", got )" + describe_json(*it));
       }
     }
     const auto points = entry.find("controlPoints");
@@ -126,7 +123,7 @@ class MarkupsReader {
       return true;
     }
     if (!points->is_array()) {
-      fail(where + ".controlPoints", "must be an array, got " + describe(*points));
+      fail(where + ".controlPoints", "must be an array, got " + describe_json(*points));
     }
     for (std::size_t p = 0; p < points->size(); ++p) {
       control_point((*points)[p], where + ".controlPoints[" + std::to_string(p) + "]",
@@ -136,15 +133,15 @@ class MarkupsReader {
   }
 
   void control_point(const Json& point, const std::string& where, bool lps, double scale) {
-    if (!point.is_object()) fail(where, "must be a JSON object, got " + describe(point));
+    if (!point.is_object()) fail(where, "must be a JSON object, got " + describe_json(point));
     std::string label;
     if (const auto it = point.find("label"); it != point.end()) {
-      if (!it->is_string()) fail(where + ".label", "must be a string, got " + describe(*it));
+      if (!it->is_string()) fail(where + ".label", "must be a string, got " + describe_json(*it));
       label = it->get<std::string>();
     }
     if (const auto it = point.find("positionStatus"); it != point.end()) {
       if (!it->is_string()) {
-        fail(where + ".positionStatus", "must be a string, got " + describe(*it));
+        fail(where + ".positionStatus", "must be a string, got " + describe_json(*it));
       }
       const std::string status = it->get<std::string>();
       if (status != "defined") {
@@ -159,8 +156,9 @@ class MarkupsReader {
     }
     const auto position = point.find("position");
     const auto bad_position = [&] {
-      fail(where + ".position", "must be 3 finite numbers, got " +
-                                    (position == point.end() ? "nothing" : describe(*position)));
+      fail(where + ".position",
+           "must be 3 finite numbers, got " +
+               (position == point.end() ? "nothing" : describe_json(*position)));
     };
     if (position == point.end() || !position->is_array() || position->size() != 3) bad_position();
     Eigen::Vector3d xyz;

@@ -15,7 +15,7 @@ namespace {
 // Traversal stacks hold at most one pending entry per level (closest point,
 // first hit) or two (all hits); the median split bounds the depth by
 // ceil(log2 #F) <= 31 for any int-indexed mesh.
-constexpr int kStackSize = 64;
+constexpr int kTraversalStackSize = 64;
 
 // A hit this far outside a triangle (barycentric units) still counts, so that a
 // ray through a shared edge is caught by at least one of the two faces.
@@ -310,7 +310,7 @@ void AabbTree::build(const Options& options) {
   state.max_leaf_size = options.max_leaf_size;
   build_node(state, 0, static_cast<int>(num_faces), 0);
   depth_ = state.max_depth;
-  assert(depth_ < kStackSize - 1);
+  assert(depth_ < kTraversalStackSize - 1);
 
   build_compact();
   box_pad_ = kBoxPad * std::max(bounds().diagonal().norm(), std::numeric_limits<double>::min());
@@ -371,7 +371,7 @@ AabbTree::ClosestPoint AabbTree::search_closest(const Eigen::Vector3d& query, do
     int code;  // pair index, or ~leaf index
     double squared_distance;
   };
-  std::array<Entry, kStackSize> stack{};
+  std::array<Entry, kTraversalStackSize> stack{};
   int top = 0;
   double best = bound;
   int best_position = -1;
@@ -486,7 +486,7 @@ std::optional<AabbTree::RayHit> AabbTree::first_hit(const Eigen::Vector3d& origi
     int node;
     double t_enter;
   };
-  std::array<Entry, kStackSize> stack{};
+  std::array<Entry, kTraversalStackSize> stack{};
   int top = 0;
   double best_t = t_max;
   int best_position = -1;
@@ -556,7 +556,7 @@ std::vector<AabbTree::RayHit> AabbTree::all_hits(const Eigen::Vector3d& origin,
   std::vector<RayHit> hits;
   if (t_max < 0) return hits;
   const Ray ray = make_ray(origin, direction);
-  std::array<int, kStackSize> stack{};
+  std::array<int, kTraversalStackSize> stack{};
   int top = 0;
   if (ray_box_entry(ray, nodes_.front().box, box_pad_, t_max))
     stack[static_cast<size_t>(top++)] = 0;

@@ -30,6 +30,10 @@ struct DoubleTraits : public OpenMesh::DefaultTraits {
 };
 using Mesh = OpenMesh::TriMesh_ArrayKernelT<DoubleTraits>;
 
+// A point of the half-edge form as an Eigen vector, and back.
+inline Eigen::Vector3d to_eigen(const Mesh::Point& p) { return {p[0], p[1], p[2]}; }
+inline Mesh::Point to_mesh_point(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+
 // Faces OpenMesh refused while building the half-edge form (a face that would
 // make an edge non-manifold, or repeats a vertex). Indices into the input F.
 struct ConversionReport {

@@ -90,9 +90,6 @@ constexpr size_t kMaxValence = 20;
 // when some face is nearly perpendicular to it (cosine below this).
 constexpr double kMinNudgeCosine = 0.05;
 
-Vec3 to_eigen(const Mesh::Point& p) { return {p[0], p[1], p[2]}; }
-Mesh::Point to_point(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
-
 // Half-space n . x >= d, in coordinates relative to the edge midpoint.
 struct Plane {
   Vec3 n;
@@ -571,7 +568,7 @@ IndexedMesh progressive_hull(const IndexedMesh& mesh, const ProgressiveHullOptio
     }
     const Mesh::VertexHandle kept = halfedge.to_vertex_handle(h);
     halfedge.collapse(h);
-    halfedge.set_point(kept, to_point(placement->position));
+    halfedge.set_point(kept, to_mesh_point(placement->position));
     faces -= 2;
     // Every edge whose neighbourhood holds a face of the new fan.
     ++round;

@@ -36,9 +36,6 @@ using Point = Mesh::Point;
 // target this small is almost certainly a unit mistake (m instead of mm).
 constexpr double kMaxOutputFaces = 2e7;
 
-Eigen::Vector3d to_eigen(const Point& p) { return {p[0], p[1], p[2]}; }
-Point to_point(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
-
 // Twice the area vector of triangle (a, b, c).
 Eigen::Vector3d area_vector(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                             const Eigen::Vector3d& c) {
@@ -112,7 +109,7 @@ class Remesher {
         const auto h = mesh_.halfedge_handle(e, 0);
         const Eigen::Vector3d midpoint =
             0.5 * (position(mesh_.to_vertex_handle(h)) + position(mesh_.from_vertex_handle(h)));
-        mesh_.split(e, to_point(midpoint));
+        mesh_.split(e, to_mesh_point(midpoint));
         split_any = true;
       }
     }
@@ -160,7 +157,7 @@ class Remesher {
       }
     }
     if (!collapse_keeps_orientation(h, target)) return false;
-    mesh_.set_point(v1, to_point(target));
+    mesh_.set_point(v1, to_mesh_point(target));
     mesh_.collapse(h);
     return true;
   }
@@ -226,14 +223,14 @@ class Remesher {
       relaxed[static_cast<size_t>(v.idx())] = centroid + n * n.dot(p - centroid);
     }
     for (const auto v : mesh_.vertices()) {
-      mesh_.set_point(v, to_point(relaxed[static_cast<size_t>(v.idx())]));
+      mesh_.set_point(v, to_mesh_point(relaxed[static_cast<size_t>(v.idx())]));
     }
   }
 
   void project_to_surface() {
     for (const auto v : mesh_.vertices()) {
       if (mesh_.is_boundary(v)) continue;
-      mesh_.set_point(v, to_point(tree_.closest_point(position(v)).point));
+      mesh_.set_point(v, to_mesh_point(tree_.closest_point(position(v)).point));
     }
   }
 

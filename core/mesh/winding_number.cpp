@@ -14,7 +14,7 @@ namespace {
 
 // The traversal pushes both children of a visited node: at most one pending
 // entry per level plus one, and the tree depth is at most 31 (median split).
-constexpr int kStackSize = 64;
+constexpr int kBallTraversalStackSize = 64;
 
 // q counts as lying in a triangle's plane when the triple product is below
 // this fraction of |a||b||c|: rounding (~1e-16 relative) decides its sign there.
@@ -175,7 +175,7 @@ WindingNumber::WindingNumber(const AabbTree& tree, const Options& options)
 
 double WindingNumber::at(const Eigen::Vector3d& q) const {
   if (!q.allFinite()) throw InvalidInputError("WindingNumber::at: the query point is not finite");
-  std::array<int, kStackSize> stack{};
+  std::array<int, kBallTraversalStackSize> stack{};
   int top = 0;
   stack[static_cast<size_t>(top++)] = 0;
   double total = 0;
@@ -195,7 +195,7 @@ double WindingNumber::at(const Eigen::Vector3d& q) const {
       }
       continue;
     }
-    assert(top + 2 <= kStackSize);
+    assert(top + 2 <= kBallTraversalStackSize);
     stack[static_cast<size_t>(top++)] = ball.second_child;
     stack[static_cast<size_t>(top++)] = n + 1;
   }

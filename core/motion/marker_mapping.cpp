@@ -12,11 +12,11 @@
 namespace mmm::motion {
 namespace {
 
-constexpr double kFormat = 1;
+constexpr double kMarkerMappingFormat = 1;
 
-class Reader {
+class MarkerMappingReader {
  public:
-  explicit Reader(std::filesystem::path file) : file_(std::move(file)) {}
+  explicit MarkerMappingReader(std::filesystem::path file) : file_(std::move(file)) {}
 
   [[noreturn]] void fail(const YAML::Node& node, const std::string& field,
                          const std::string& problem) const {
@@ -82,11 +82,11 @@ class Reader {
 };
 
 MarkerMapping parse_root(const YAML::Node& root, const std::filesystem::path& file) {
-  const Reader reader(file);
+  const MarkerMappingReader reader(file);
   if (!root.IsMap()) reader.fail(root, "(top)", "expects a mapping holding mmm_marker_mapping: 1");
   reader.check_keys(root, "(top)",
                     {"mmm_marker_mapping", "name", "description", "markers", "coordinates"});
-  if (reader.number(root, "mmm_marker_mapping", "(top)", -1, -1e9) != kFormat) {
+  if (reader.number(root, "mmm_marker_mapping", "(top)", -1, -1e9) != kMarkerMappingFormat) {
     reader.fail(root, "mmm_marker_mapping",
                 "must be 1 (this file is not an mmm marker mapping, or a newer one)");
   }

@@ -7,7 +7,7 @@
 namespace mmm::motion {
 namespace {
 
-constexpr const char* kFormat = "mmm-motion 1";
+constexpr const char* kMotionFormat = "mmm-motion 1";
 
 nlohmann::json pose_json(const Eigen::Isometry3d& pose) {
   nlohmann::json row = nlohmann::json::array();
@@ -51,7 +51,7 @@ std::vector<std::string> names(const nlohmann::json& value, std::string_view wha
 nlohmann::json motion_to_json(const FusedMotion& motion, const std::string& model,
                               const std::string& model_kind) {
   nlohmann::json json;
-  json["format"] = kFormat;
+  json["format"] = kMotionFormat;
   json["model"] = model;
   json["model_kind"] = model_kind;
   json["frame"] = model_kind == "atlas"
@@ -91,8 +91,9 @@ nlohmann::json motion_to_json(const FusedMotion& motion, const std::string& mode
 }
 
 FusedMotion motion_from_json(const nlohmann::json& json, std::string_view what) {
-  if (!json.is_object() || json.value("format", "") != kFormat) {
-    fail(what, R"(not a fused motion (expected "format": ")" + std::string(kFormat) + R"("))");
+  if (!json.is_object() || json.value("format", "") != kMotionFormat) {
+    fail(what,
+         R"(not a fused motion (expected "format": ")" + std::string(kMotionFormat) + R"("))");
   }
   FusedMotion motion;
   const nlohmann::json& times = field(json, "times", what, "");

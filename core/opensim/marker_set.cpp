@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/opensim/text_parsing.h"
 
 namespace mmm::opensim {
 
@@ -22,59 +23,17 @@ namespace {
 
 using tinyxml2::XMLElement;
 
-constexpr std::size_t kMaxShown = 40;
 // An <IKTaskSet file=...> chain longer than this is taken for a cycle.
 constexpr int kMaxFileDepth = 8;
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
-
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && is_space(text.front())) text.remove_prefix(1);
-  while (!text.empty() && is_space(text.back())) text.remove_suffix(1);
-  return text;
-}
-
-std::vector<std::string_view> split_words(std::string_view text) {
-  std::vector<std::string_view> words;
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    while (pos < text.size() && is_space(text[pos])) ++pos;
-    const std::size_t start = pos;
-    while (pos < text.size() && !is_space(text[pos])) ++pos;
-    if (pos > start) words.push_back(text.substr(start, pos - start));
-  }
-  return words;
-}
-
-bool parse_double(std::string_view token, double& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return false;
-  const char* end = token.data() + token.size();
-  const auto [ptr, error] = std::from_chars(token.data(), end, value);
-  return error == std::errc() && ptr == end;
-}
-
-std::string quote(std::string_view text) {
-  if (text.size() > kMaxShown) return "'" + std::string(text.substr(0, kMaxShown)) + "...'";
-  return "'" + std::string(text) + "'";
-}
-
-std::string lower(std::string_view text) {
-  std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](char c) {
-    return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
-  });
-  return out;
-}
-
-std::string_view text_of(const XMLElement& element) {
+std::string_view trimmed_text_of(const XMLElement& element) {
   const char* text = element.GetText();
-  return text != nullptr ? trim(text) : std::string_view();
+  return text != nullptr ? trim_xml_space(text) : std::string_view();
 }
 
-std::string name_of(const XMLElement& element) {
+std::string trimmed_name_of(const XMLElement& element) {
   const char* name = element.Attribute("name");
-  return name != nullptr ? std::string(trim(name)) : std::string();
+  return name != nullptr ? std::string(trim_xml_space(name)) : std::string();
 }
 
 // "line N: <Tag name="x">: "
@@ -82,23 +41,6 @@ std::string at(const XMLElement& element) {
   const char* name = element.Attribute("name");
   return "line " + std::to_string(element.GetLineNum()) + ": <" + element.Name() +
          (name != nullptr ? " name=\"" + std::string(name) + "\"" : "") + ">: ";
-}
-
-std::string read_whole_file(const std::filesystem::path& file) {
-  std::error_code error;
-  if (!std::filesystem::exists(file, error)) {
-    throw IoError(file, "no such file; check the path (relative paths are taken from " +
-                            std::filesystem::current_path(error).string() + ")");
-  }
-  if (std::filesystem::is_directory(file, error)) {
-    throw IoError(file, "is a folder, expected an OpenSim XML file");
-  }
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw IoError(file, "cannot be opened for reading (permissions?)");
-  std::ostringstream content;
-  content << in.rdbuf();
-  if (in.bad()) throw IoError(file, "read failed part-way (I/O error)");
-  return std::move(content).str();
 }
 
 void parse_xml(tinyxml2::XMLDocument& document, std::string_view xml,
@@ -115,10 +57,11 @@ void parse_xml(tinyxml2::XMLDocument& document, std::string_view xml,
 }
 
 bool parse_bool(const std::filesystem::path& name, const XMLElement& element) {
-  const std::string value = lower(text_of(element));
+  const std::string value = ascii_lower(trimmed_text_of(element));
   if (value == "true" || value == "1") return true;
   if (value == "false" || value == "0") return false;
-  throw IoError(name, at(element) + "expected true or false, got " + quote(text_of(element)));
+  throw IoError(name, at(element) + "expected true or false, got " +
+                          quote_for_message(trimmed_text_of(element)));
 }
 
 // Body name from a 3.x <body> or a 4.x socket path.
@@ -131,7 +74,7 @@ std::string body_from(std::string_view text) {
 
 MarkerDefinition parse_marker(const std::filesystem::path& name, const XMLElement& element) {
   MarkerDefinition marker;
-  marker.name = name_of(element);
+  marker.name = trimmed_name_of(element);
   if (marker.name.empty()) {
     throw IoError(name, at(element) +
                             "the marker has no name attribute; the IK and Scale tools "
@@ -139,27 +82,28 @@ MarkerDefinition parse_marker(const std::filesystem::path& name, const XMLElemen
   }
   const XMLElement* frame = element.FirstChildElement("socket_parent_frame");
   if (frame == nullptr) frame = element.FirstChildElement("body");
-  if (frame == nullptr || text_of(*frame).empty()) {
+  if (frame == nullptr || trimmed_text_of(*frame).empty()) {
     throw IoError(name, at(element) +
                             "expected the body the marker sits on, as <socket_parent_frame> "
                             "(OpenSim 4) or <body> (OpenSim 3); found none or an empty one");
   }
-  marker.body = body_from(text_of(*frame));
+  marker.body = body_from(trimmed_text_of(*frame));
   const XMLElement* location = element.FirstChildElement("location");
   if (location == nullptr) {
     throw IoError(name, at(element) + "no <location>; expected 3 numbers (m, body frame)");
   }
-  const std::vector<std::string_view> words = split_words(text_of(*location));
+  const std::vector<std::string_view> words = split_xml_words(trimmed_text_of(*location));
   if (words.size() != 3) {
     throw IoError(name, at(*location) + "expected 3 numbers (x y z in m) in the location of " +
-                            quote(marker.name) + ", got " + std::to_string(words.size()));
+                            quote_for_message(marker.name) + ", got " +
+                            std::to_string(words.size()));
   }
   for (int i = 0; i < 3; ++i) {
     double value = 0.0;
-    if (!parse_double(words[static_cast<std::size_t>(i)], value) || !std::isfinite(value)) {
+    if (!parse_double_token(words[static_cast<std::size_t>(i)], value) || !std::isfinite(value)) {
       throw IoError(name, at(*location) + "coordinate " + std::to_string(i) + " of " +
-                              quote(marker.name) + " is " +
-                              quote(words[static_cast<std::size_t>(i)]) +
+                              quote_for_message(marker.name) + " is " +
+                              quote_for_message(words[static_cast<std::size_t>(i)]) +
                               ", expected a finite number (m)");
     }
     marker.location(i) = value;
@@ -204,20 +148,22 @@ std::map<std::string, IkMarkerWeight> parse_tasks(std::string_view xml,
                             "(an IK setup) or <IKTaskSet> (a task-set file)");
   }
   const char* reference = set->Attribute("file");
-  if (reference != nullptr && !trim(reference).empty()) {
+  if (reference != nullptr && !trim_xml_space(reference).empty()) {
     if (depth >= kMaxFileDepth) {
       throw IoError(name, at(*set) + "task-set files refer to each other more than " +
                               std::to_string(kMaxFileDepth) + " deep; a cycle?");
     }
-    const std::filesystem::path referenced = name.parent_path() / std::string(trim(reference));
-    return parse_tasks(read_whole_file(referenced), referenced, depth + 1);
+    const std::filesystem::path referenced =
+        name.parent_path() / std::string(trim_xml_space(reference));
+    return parse_tasks(read_whole_text_file(referenced, "an OpenSim XML file"), referenced,
+                       depth + 1);
   }
   std::map<std::string, IkMarkerWeight> weights;
   const XMLElement* objects = set->FirstChildElement("objects");
   if (objects == nullptr) return weights;
   for (const XMLElement* task = objects->FirstChildElement("IKMarkerTask"); task != nullptr;
        task = task->NextSiblingElement("IKMarkerTask")) {
-    const std::string marker = name_of(*task);
+    const std::string marker = trimmed_name_of(*task);
     if (marker.empty()) {
       throw IoError(name, at(*task) + "the task has no name attribute; expected the marker name");
     }
@@ -226,14 +172,15 @@ std::map<std::string, IkMarkerWeight> parse_tasks(std::string_view xml,
       weight.apply = parse_bool(name, *apply);
     }
     if (const XMLElement* value = task->FirstChildElement("weight"); value != nullptr) {
-      if (!parse_double(text_of(*value), weight.weight) || !std::isfinite(weight.weight) ||
-          weight.weight < 0.0) {
-        throw IoError(name, at(*value) + "the weight of " + quote(marker) + " is " +
-                                quote(text_of(*value)) + ", expected a finite number >= 0");
+      if (!parse_double_token(trimmed_text_of(*value), weight.weight) ||
+          !std::isfinite(weight.weight) || weight.weight < 0.0) {
+        throw IoError(name, at(*value) + "the weight of " + quote_for_message(marker) + " is " +
+                                quote_for_message(trimmed_text_of(*value)) +
+                                ", expected a finite number >= 0");
       }
     }
     if (!weights.emplace(marker, weight).second) {
-      throw IoError(name, at(*task) + "a second task for marker " + quote(marker) +
+      throw IoError(name, at(*task) + "a second task for marker " + quote_for_message(marker) +
                               "; expected one task per marker");
     }
   }
@@ -243,7 +190,7 @@ std::map<std::string, IkMarkerWeight> parse_tasks(std::string_view xml,
 }  // namespace
 
 std::vector<MarkerDefinition> read_marker_set(const std::filesystem::path& file) {
-  return parse_marker_set(read_whole_file(file), file);
+  return parse_marker_set(read_whole_text_file(file, "an OpenSim XML file"), file);
 }
 
 std::vector<MarkerDefinition> parse_marker_set(std::string_view xml,
@@ -265,7 +212,8 @@ std::vector<MarkerDefinition> parse_marker_set(std::string_view xml,
        element = element->NextSiblingElement("Marker")) {
     MarkerDefinition marker = parse_marker(name_for_messages, *element);
     if (!seen.insert(marker.name).second) {
-      throw IoError(name_for_messages, at(*element) + "the marker name " + quote(marker.name) +
+      throw IoError(name_for_messages, at(*element) + "the marker name " +
+                                           quote_for_message(marker.name) +
                                            " is used twice; expected unique names");
     }
     markers.push_back(std::move(marker));
@@ -274,7 +222,7 @@ std::vector<MarkerDefinition> parse_marker_set(std::string_view xml,
 }
 
 std::map<std::string, IkMarkerWeight> read_ik_task_weights(const std::filesystem::path& setup) {
-  return parse_tasks(read_whole_file(setup), setup, 0);
+  return parse_tasks(read_whole_text_file(setup, "an OpenSim XML file"), setup, 0);
 }
 
 std::map<std::string, IkMarkerWeight> parse_ik_task_weights(

@@ -14,115 +14,31 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/opensim/text_parsing.h"
 
 namespace mmm::opensim {
 
 namespace {
 
-constexpr std::size_t kMaxShown = 40;
 constexpr std::size_t kMaxListed = 12;
-constexpr int kMaxDecimals = 20;
-
-struct Line {
-  std::string_view text;
-  int number = 0;  // 1-based
-};
-
-// Lines of `text`, split at LF, CRLF or a lone CR, without the line ends. A
-// leading UTF-8 byte order mark is dropped.
-std::vector<Line> split_lines(std::string_view text) {
-  constexpr std::string_view kBom = "\xEF\xBB\xBF";
-  if (text.substr(0, kBom.size()) == kBom) text.remove_prefix(kBom.size());
-  std::vector<Line> lines;
-  std::size_t start = 0;
-  int number = 1;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (c != '\n' && c != '\r') continue;
-    lines.push_back({text.substr(start, i - start), number++});
-    if (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
-    start = i + 1;
-  }
-  if (start < text.size()) lines.push_back({text.substr(start), number});
-  return lines;
-}
-
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
-
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && is_blank(text.front())) text.remove_prefix(1);
-  while (!text.empty() && is_blank(text.back())) text.remove_suffix(1);
-  return text;
-}
+constexpr int kMaxMotDecimals = 20;
 
 // Tokens separated by runs of tabs and spaces.
-void split_words(std::string_view line, std::vector<std::string_view>& words) {
+void split_line_words(std::string_view line, std::vector<std::string_view>& words) {
   words.clear();
   std::size_t pos = 0;
   while (pos < line.size()) {
-    while (pos < line.size() && is_blank(line[pos])) ++pos;
+    while (pos < line.size() && is_line_blank(line[pos])) ++pos;
     const std::size_t start = pos;
-    while (pos < line.size() && !is_blank(line[pos])) ++pos;
+    while (pos < line.size() && !is_line_blank(line[pos])) ++pos;
     if (pos > start) words.push_back(line.substr(start, pos - start));
   }
-}
-
-bool parse_double(std::string_view token, double& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return false;
-  const char* end = token.data() + token.size();
-  const auto [ptr, error] = std::from_chars(token.data(), end, value);
-  return error == std::errc() && ptr == end;
-}
-
-bool parse_int(std::string_view token, int& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return false;
-  const char* end = token.data() + token.size();
-  const auto [ptr, error] = std::from_chars(token.data(), end, value);
-  return error == std::errc() && ptr == end;
-}
-
-std::string quote(std::string_view text) {
-  if (text.size() > kMaxShown) return "'" + std::string(text.substr(0, kMaxShown)) + "...'";
-  return "'" + std::string(text) + "'";
-}
-
-std::string lower(std::string_view text) {
-  std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](char c) {
-    return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
-  });
-  return out;
-}
-
-std::string format_double(double value) {
-  std::array<char, 64> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return {buffer.data(), result.ptr};
-}
-
-std::string read_whole_file(const std::filesystem::path& file) {
-  std::error_code error;
-  if (!std::filesystem::exists(file, error)) {
-    throw IoError(file, "no such file; check the path (relative paths are taken from " +
-                            std::filesystem::current_path(error).string() + ")");
-  }
-  if (std::filesystem::is_directory(file, error)) {
-    throw IoError(file, "is a folder, expected a .mot or .sto file");
-  }
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw IoError(file, "cannot be opened for reading (permissions?)");
-  std::ostringstream content;
-  content << in.rdbuf();
-  if (in.bad()) throw IoError(file, "read failed part-way (I/O error)");
-  return std::move(content).str();
 }
 
 enum class HeaderKey { kName, kVersion, kRows, kColumns, kInDegrees, kDataType, kOther };
 
 HeaderKey classify(std::string_view key) {
-  const std::string k = lower(key);
+  const std::string k = ascii_lower(key);
   if (k == "name") return HeaderKey::kName;
   if (k == "version") return HeaderKey::kVersion;
   if (k == "nrows" || k == "datarows" || k == "nr") return HeaderKey::kRows;
@@ -142,7 +58,7 @@ struct Announced {
 class MotParser {
  public:
   MotParser(std::string_view text, std::filesystem::path name, const StorageReadOptions& options)
-      : name_(std::move(name)), options_(options), lines_(split_lines(text)) {}
+      : name_(std::move(name)), options_(options), lines_(split_text_lines(text)) {}
 
   StorageTable parse() {
     out_.source = name_;
@@ -158,15 +74,15 @@ class MotParser {
     throw IoError(name_, "line " + std::to_string(line) + ": " + problem);
   }
   [[noreturn]] void fail(int line, std::string_view column, const std::string& problem) const {
-    throw IoError(name_,
-                  "line " + std::to_string(line) + ", column " + quote(column) + ": " + problem);
+    throw IoError(name_, "line " + std::to_string(line) + ", column " + quote_for_message(column) +
+                             ": " + problem);
   }
 
   // Returns the index of the first line after "endheader".
   std::size_t parse_header() {
     std::size_t end = lines_.size();
     for (std::size_t i = 0; i < lines_.size(); ++i) {
-      if (lower(trim(lines_[i].text)) == "endheader") {
+      if (ascii_lower(trim_line_blanks(lines_[i].text)) == "endheader") {
         end = i;
         break;
       }
@@ -175,7 +91,7 @@ class MotParser {
       std::string hint =
           "; expected an OpenSim storage header (name, version=1, nRows=..., "
           "nColumns=..., inDegrees=yes|no) ending in a line 'endheader'";
-      if (!lines_.empty() && trim(lines_[0].text).substr(0, 12) == "PathFileType") {
+      if (!lines_.empty() && trim_line_blanks(lines_[0].text).substr(0, 12) == "PathFileType") {
         hint += "; this looks like a .trc marker file: read it with read_trc";
       }
       throw IoError(
@@ -185,22 +101,23 @@ class MotParser {
     return end + 1;
   }
 
-  void parse_header_line(const Line& line, bool first) {
-    const std::string_view text = trim(line.text);
+  void parse_header_line(const TextLine& line, bool first) {
+    const std::string_view text = trim_line_blanks(line.text);
     if (text.empty() || text.front() == '#') {
-      if (lower(text).find("simm") != std::string::npos) simm_header_ = true;
+      if (ascii_lower(text).find("simm") != std::string::npos) simm_header_ = true;
       return;
     }
     std::string_view key;
     std::string_view value;
     const std::size_t equals = text.find('=');
     if (equals != std::string_view::npos) {
-      key = trim(text.substr(0, equals));
-      value = trim(text.substr(equals + 1));
+      key = trim_line_blanks(text.substr(0, equals));
+      value = trim_line_blanks(text.substr(equals + 1));
     } else {
       const std::size_t blank = text.find_first_of(" \t");
       key = text.substr(0, blank);
-      value = blank == std::string_view::npos ? std::string_view() : trim(text.substr(blank));
+      value = blank == std::string_view::npos ? std::string_view()
+                                              : trim_line_blanks(text.substr(blank));
     }
     const HeaderKey kind = classify(key);
     if (first && equals == std::string_view::npos && (kind == HeaderKey::kOther || value.empty())) {
@@ -213,38 +130,39 @@ class MotParser {
         break;
       case HeaderKey::kVersion: {
         int version = 0;
-        if (!parse_int(value, version) || version < 0) {
-          fail(line.number, key, "expected a version number such as 1, got " + quote(value));
+        if (!parse_int_token(value, version) || version < 0) {
+          fail(line.number, key,
+               "expected a version number such as 1, got " + quote_for_message(value));
         }
         break;
       }
       case HeaderKey::kRows:
       case HeaderKey::kColumns: {
         int count = 0;
-        if (!parse_int(value, count) || count < 0) {
-          fail(line.number, key, "expected a count >= 0, got " + quote(value));
+        if (!parse_int_token(value, count) || count < 0) {
+          fail(line.number, key, "expected a count >= 0, got " + quote_for_message(value));
         }
-        if (lower(key).rfind("data", 0) == 0) simm_header_ = true;
+        if (ascii_lower(key).rfind("data", 0) == 0) simm_header_ = true;
         (kind == HeaderKey::kRows ? rows_ : columns_)
             .push_back({std::string(key), count, line.number});
         break;
       }
       case HeaderKey::kInDegrees: {
-        const std::string flag = lower(value);
+        const std::string flag = ascii_lower(value);
         if (flag == "yes" || flag == "true") {
           out_.in_degrees = true;
         } else if (flag == "no" || flag == "false") {
           out_.in_degrees = false;
         } else {
-          fail(line.number, key, "expected yes or no, got " + quote(value));
+          fail(line.number, key, "expected yes or no, got " + quote_for_message(value));
         }
         out_.in_degrees_stated = true;
         break;
       }
       case HeaderKey::kDataType:
-        if (lower(value) != "double") {
+        if (ascii_lower(value) != "double") {
           fail(line.number, key,
-               "expected DataType=double, got " + quote(value) +
+               "expected DataType=double, got " + quote_for_message(value) +
                    "; tables of Vec3/Quaternion/SpatialVec columns are not read here");
         }
         break;
@@ -256,19 +174,19 @@ class MotParser {
   // Parses the label line (the first non-blank line at or after `index`);
   // returns the index of the line after it.
   std::size_t parse_labels(std::size_t index) {
-    while (index < lines_.size() && trim(lines_[index].text).empty()) ++index;
+    while (index < lines_.size() && trim_line_blanks(lines_[index].text).empty()) ++index;
     const int after_header = index > 0 ? lines_[index - 1].number : 0;
     if (index == lines_.size()) {
       fail(after_header,
            "the file ends after 'endheader'; expected a line of column labels "
            "starting with 'time'");
     }
-    const Line& line = lines_[index];
+    const TextLine& line = lines_[index];
     std::vector<std::string_view> labels;
-    split_words(line.text, labels);
-    if (lower(labels.front()) != "time") {
+    split_line_words(line.text, labels);
+    if (ascii_lower(labels.front()) != "time") {
       fail(line.number, labels.front(),
-           "expected 'time' as the first column label, got " + quote(labels.front()) +
+           "expected 'time' as the first column label, got " + quote_for_message(labels.front()) +
                "; hint: OpenSim needs the time in the first column");
     }
     labels_line_ = line.number;
@@ -279,8 +197,8 @@ class MotParser {
     }
     for (const auto& [label, count] : counts) {
       if (count > 1) {
-        out_.warnings.push_back("line " + std::to_string(line.number) + ": column " + quote(label) +
-                                " appears " + std::to_string(count) +
+        out_.warnings.push_back("line " + std::to_string(line.number) + ": column " +
+                                quote_for_message(label) + " appears " + std::to_string(count) +
                                 " times; column() returns the first");
       }
     }
@@ -301,8 +219,8 @@ class MotParser {
     int previous_line = 0;
     double previous_time = 0.0;
     for (std::size_t i = first; i < lines_.size(); ++i) {
-      const Line& line = lines_[i];
-      split_words(line.text, fields);
+      const TextLine& line = lines_[i];
+      split_line_words(line.text, fields);
       if (fields.empty()) continue;
       if (fields.size() != width) {
         fail(line.number, "the row has " + std::to_string(fields.size()) +
@@ -310,16 +228,17 @@ class MotParser {
                               ", time included, line " + std::to_string(labels_line_) + ")");
       }
       double time = 0.0;
-      if (!parse_double(fields[0], time)) {
-        fail(line.number, "time", "expected a number of seconds, got " + quote(fields[0]));
+      if (!parse_double_token(fields[0], time)) {
+        fail(line.number, "time",
+             "expected a number of seconds, got " + quote_for_message(fields[0]));
       }
       if (!std::isfinite(time)) {
-        fail(line.number, "time", "expected a finite time, got " + quote(fields[0]));
+        fail(line.number, "time", "expected a finite time, got " + quote_for_message(fields[0]));
       }
       if (previous_line > 0 && !(time > previous_time)) {
         fail(line.number, "time",
-             "time " + format_double(time) + " s does not increase, expected more than " +
-                 format_double(previous_time) + " s (line " + std::to_string(previous_line) +
+             "time " + shortest_double_text(time) + " s does not increase, expected more than " +
+                 shortest_double_text(previous_time) + " s (line " + std::to_string(previous_line) +
                  "); hint: duplicated or unsorted rows");
       }
       previous_line = line.number;
@@ -327,9 +246,9 @@ class MotParser {
       times_.push_back(time);
       for (std::size_t c = 1; c < width; ++c) {
         double value = 0.0;
-        if (!parse_double(fields[c], value)) {
+        if (!parse_double_token(fields[c], value)) {
           fail(line.number, out_.column_names[c - 1],
-               "expected a number (or NaN), got " + quote(fields[c]));
+               "expected a number (or NaN), got " + quote_for_message(fields[c]));
         }
         values_.push_back(value);
       }
@@ -365,7 +284,7 @@ class MotParser {
 
   std::filesystem::path name_;
   StorageReadOptions options_;
-  std::vector<Line> lines_;
+  std::vector<TextLine> lines_;
   StorageTable out_;
   bool simm_header_ = false;
   std::vector<Announced> rows_;
@@ -375,28 +294,13 @@ class MotParser {
   std::vector<double> values_;  // row-major #rows by #columns
 };
 
-void append_number(std::string& out, double value, int decimals) {
-  if (std::isnan(value)) {
-    out += "NaN";
-    return;
-  }
-  // Fixed notation of the largest double needs 309 digits before the point.
-  std::array<char, 400> buffer{};
-  char* const first = buffer.data();
-  char* const last = buffer.data() + buffer.size();
-  const std::to_chars_result result =
-      decimals < 0 ? std::to_chars(first, last, value)
-                   : std::to_chars(first, last, value, std::chars_format::fixed, decimals);
-  out.append(first, result.ptr);
-}
-
 void check_for_writing(const StorageTable& table, const StorageWriteOptions& options) {
   const auto fail = [](const std::string& problem) {
     throw InvalidInputError("write_mot: " + problem);
   };
-  if (options.decimals > kMaxDecimals) {
+  if (options.decimals > kMaxMotDecimals) {
     fail("decimals " + std::to_string(options.decimals) + " exceeds " +
-         std::to_string(kMaxDecimals) + "; use a negative value for exact round trips");
+         std::to_string(kMaxMotDecimals) + "; use a negative value for exact round trips");
   }
   const Eigen::Index rows = table.times.size();
   if (table.values.rows() != rows || table.values.cols() != table.num_columns()) {
@@ -407,19 +311,19 @@ void check_for_writing(const StorageTable& table, const StorageWriteOptions& opt
   for (Eigen::Index r = 0; r < rows; ++r) {
     if (!std::isfinite(table.times(r)) || (r > 0 && !(table.times(r) > table.times(r - 1)))) {
       fail("times must be finite and strictly increasing; row " + std::to_string(r) + " has " +
-           format_double(table.times(r)) + " s");
+           shortest_double_text(table.times(r)) + " s");
     }
   }
   for (const std::string& column : table.column_names) {
     if (column.empty() || column.find_first_of(" \t\r\n\v\f") != std::string::npos ||
-        lower(column) == "time") {
-      fail("column name " + quote(column) +
+        ascii_lower(column) == "time") {
+      fail("column name " + quote_for_message(column) +
            " is empty, 'time' or contains blanks; readers split labels at blanks");
     }
   }
   if (table.name.find_first_of("=\r\n") != std::string::npos ||
-      lower(trim(table.name)) == "endheader") {
-    fail("table name " + quote(table.name) +
+      ascii_lower(trim_line_blanks(table.name)) == "endheader") {
+    fail("table name " + quote_for_message(table.name) +
          " contains '=' or a line break or is 'endheader'; it would be read as a header key");
   }
 }
@@ -435,8 +339,8 @@ Eigen::Index require_column(const StorageTable& table, std::string_view column_n
     listed += (i > 0 ? ", " : "") + names[i];
   }
   if (names.size() > kMaxListed) listed += ", ...";
-  throw InvalidInputError(table.source.string() + ": no column " + quote(column_name) + "; the " +
-                          std::to_string(names.size()) + " columns are " + listed);
+  throw InvalidInputError(table.source.string() + ": no column " + quote_for_message(column_name) +
+                          "; the " + std::to_string(names.size()) + " columns are " + listed);
 }
 
 }  // namespace
@@ -455,11 +359,11 @@ Eigen::RowVectorXd StorageTable::interpolate(double t) const {
   const Eigen::Index rows = times.size();
   if (rows == 0 || values.rows() != rows || !std::isfinite(t) || t < times(0) ||
       t > times(rows - 1)) {
-    throw InvalidInputError(source.string() + ": time " + format_double(t) +
+    throw InvalidInputError(source.string() + ": time " + shortest_double_text(t) +
                             " s is outside the table's " +
                             (rows == 0 ? std::string("empty range")
-                                       : "range [" + format_double(times(0)) + ", " +
-                                             format_double(times(rows - 1)) + "] s") +
+                                       : "range [" + shortest_double_text(times(0)) + ", " +
+                                             shortest_double_text(times(rows - 1)) + "] s") +
                             "; no extrapolation");
   }
   const double* begin = times.data();
@@ -477,7 +381,7 @@ double StorageTable::value_at(std::string_view column_name, double t) const {
 }
 
 StorageTable read_mot(const std::filesystem::path& file, const StorageReadOptions& options) {
-  return parse_mot(read_whole_file(file), file, options);
+  return parse_mot(read_whole_text_file(file, "a .mot or .sto file"), file, options);
 }
 
 StorageTable parse_mot(std::string_view text, const std::filesystem::path& name_for_messages,
@@ -492,18 +396,19 @@ void write_mot(const StorageTable& table, const std::filesystem::path& file,
   const Eigen::Index columns = table.num_columns();
   std::string out;
   out.reserve(static_cast<std::size_t>(rows * (columns + 1) * 12 + 512));
-  const std::string name =
-      trim(table.name).empty() ? file.stem().string() : std::string(trim(table.name));
+  const std::string name = trim_line_blanks(table.name).empty()
+                               ? file.stem().string()
+                               : std::string(trim_line_blanks(table.name));
   out += name + "\nversion=1\nnRows=" + std::to_string(rows) +
          "\nnColumns=" + std::to_string(columns + 1) +
          "\ninDegrees=" + (table.in_degrees ? "yes" : "no") + "\nendheader\ntime";
   for (const std::string& column : table.column_names) out += "\t" + column;
   out += '\n';
   for (Eigen::Index r = 0; r < rows; ++r) {
-    append_number(out, table.times(r), options.decimals);
+    append_number_text(out, table.times(r), options.decimals);
     for (Eigen::Index c = 0; c < columns; ++c) {
       out += '\t';
-      append_number(out, table.values(r, c), options.decimals);
+      append_number_text(out, table.values(r, c), options.decimals);
     }
     out += '\n';
   }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/opensim/text_parsing.h"
 
 namespace mmm::opensim {
 
@@ -41,27 +42,6 @@ constexpr std::string_view kSupportedFunctions =
     "Constant, LinearFunction, PolynomialFunction, SimmSpline, PiecewiseLinearFunction, "
     "MultiplierFunction";
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
-
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && is_space(text.front())) text.remove_prefix(1);
-  while (!text.empty() && is_space(text.back())) text.remove_suffix(1);
-  return text;
-}
-
-// Whitespace-separated tokens.
-std::vector<std::string_view> split_words(std::string_view text) {
-  std::vector<std::string_view> words;
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    while (pos < text.size() && is_space(text[pos])) ++pos;
-    const std::size_t start = pos;
-    while (pos < text.size() && !is_space(text[pos])) ++pos;
-    if (pos > start) words.push_back(text.substr(start, pos - start));
-  }
-  return words;
-}
-
 // Component path segments, without empty, "." and ".." parts.
 std::vector<std::string_view> split_path(std::string_view path) {
   std::vector<std::string_view> segments;
@@ -69,7 +49,7 @@ std::vector<std::string_view> split_path(std::string_view path) {
   while (pos <= path.size()) {
     std::size_t end = path.find('/', pos);
     if (end == std::string_view::npos) end = path.size();
-    const std::string_view segment = trim(path.substr(pos, end - pos));
+    const std::string_view segment = trim_xml_space(path.substr(pos, end - pos));
     if (!segment.empty() && segment != "." && segment != "..") segments.push_back(segment);
     pos = end + 1;
   }
@@ -80,27 +60,6 @@ std::vector<std::string_view> split_path(std::string_view path) {
 std::string last_segment(std::string_view path) {
   const std::vector<std::string_view> segments = split_path(path);
   return segments.empty() ? std::string() : std::string(segments.back());
-}
-
-bool parse_double(std::string_view token, double& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  const char* end = token.data() + token.size();
-  const auto [ptr, error] = std::from_chars(token.data(), end, value);
-  return error == std::errc() && ptr == end;
-}
-
-std::string quote_token(std::string_view text) {
-  constexpr std::size_t kMaxShown = 40;
-  if (text.size() > kMaxShown) return "'" + std::string(text.substr(0, kMaxShown)) + "...'";
-  return "'" + std::string(text) + "'";
-}
-
-std::string lower(std::string_view text) {
-  std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](char c) {
-    return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
-  });
-  return out;
 }
 
 const char* text_of(const XMLElement& element) {
@@ -251,16 +210,16 @@ class OsimReader {
 
   std::vector<double> numbers(const XMLElement& element) const {
     std::vector<double> values;
-    const std::vector<std::string_view> words = split_words(text_of(element));
+    const std::vector<std::string_view> words = split_xml_words(text_of(element));
     values.reserve(words.size());
     for (std::size_t i = 0; i < words.size(); ++i) {
       double value = 0.0;
-      if (!parse_double(words[i], value)) {
-        fail(element,
-             "value " + std::to_string(i + 1) + " is " + quote_token(words[i]) + ", not a number");
+      if (!parse_double_token(words[i], value)) {
+        fail(element, "value " + std::to_string(i + 1) + " is " + quote_for_message(words[i]) +
+                          ", not a number");
       }
       if (!std::isfinite(value)) {
-        fail(element, "value " + std::to_string(i + 1) + " is " + quote_token(words[i]) +
+        fail(element, "value " + std::to_string(i + 1) + " is " + quote_for_message(words[i]) +
                           "; expected a finite number");
       }
       values.push_back(value);
@@ -298,10 +257,11 @@ class OsimReader {
   }
 
   bool boolean(const XMLElement& element) const {
-    const std::string value = lower(trim(text_of(element)));
+    const std::string value = ascii_lower(trim_xml_space(text_of(element)));
     if (value == "true" || value == "1") return true;
     if (value == "false" || value == "0") return false;
-    fail(element, "holds " + quote_token(trim(text_of(element))) + ", expected true or false");
+    fail(element, "holds " + quote_for_message(trim_xml_space(text_of(element))) +
+                      ", expected true or false");
   }
 
   double scalar_or(const XMLElement& parent, const char* name, double fallback) const {
@@ -322,7 +282,7 @@ class OsimReader {
 
   static std::string text_or(const XMLElement& parent, const char* name) {
     const XMLElement* child = parent.FirstChildElement(name);
-    return child != nullptr ? std::string(trim(text_of(*child))) : std::string();
+    return child != nullptr ? std::string(trim_xml_space(text_of(*child))) : std::string();
   }
 
   const XMLElement& required(const XMLElement& parent, const char* name,
@@ -343,11 +303,12 @@ class OsimReader {
            "has no Version attribute; expected e.g. Version=\"40000\" (OpenSim writes "
            "it; re-save the model with OpenSim)");
     }
-    const std::string_view version_text = trim(text);
+    const std::string_view version_text = trim_xml_space(text);
     const char* end = version_text.data() + version_text.size();
     const auto [ptr, error] = std::from_chars(version_text.data(), end, version_);
     if (error != std::errc() || ptr != end) {
-      fail(root, "Version=" + quote_token(text) + " is not an integer; expected e.g. \"40000\"");
+      fail(root,
+           "Version=" + quote_for_message(text) + " is not an integer; expected e.g. \"40000\"");
     }
     if (version_ < kFirstVersion3) {
       fail(root, "Version " + std::to_string(version_) +
@@ -385,7 +346,7 @@ class OsimReader {
       wrap.xyz_body_rotation = vec3_or(element, "xyz_body_rotation", wrap.xyz_body_rotation);
       wrap.translation = vec3_or(element, "translation", wrap.translation);
       const std::string quadrant = text_or(element, "quadrant");
-      if (!quadrant.empty() && lower(quadrant) != "unassigned") wrap.quadrant = quadrant;
+      if (!quadrant.empty() && ascii_lower(quadrant) != "unassigned") wrap.quadrant = quadrant;
       wrap.active = boolean_or(element, "active", true);
       if (wrap.type == "WrapSphere") {
         wrap.shape = WrapShape::kSphere;
@@ -459,7 +420,7 @@ class OsimReader {
     if (visible == nullptr) return;
     const Eigen::Vector3d scale = vec3_or(*visible, "scale_factors", Eigen::Vector3d::Ones());
     const std::string files = text_or(*visible, "geometry_files");
-    for (const std::string_view file : split_words(files)) {
+    for (const std::string_view file : split_xml_words(files)) {
       AttachedMesh mesh;
       mesh.name = std::string(file);
       mesh.mesh_file = std::string(file);
@@ -530,8 +491,8 @@ class OsimReader {
 
   FrameRef body_frame_3(const XMLElement& where, const std::string& body) const {
     if (!body_names_.contains(body)) {
-      fail(where, "refers to body " + quote_token(body) + ", which the model does not define; " +
-                      known_bodies());
+      fail(where, "refers to body " + quote_for_message(body) +
+                      ", which the model does not define; " + known_bodies());
     }
     return body_frame(body);
   }
@@ -583,12 +544,12 @@ class OsimReader {
   FrameRef resolve_frame(const XMLElement& where, std::string_view path,
                          std::string_view context_joint, int depth) const {
     if (depth > kMaxFrameDepth) {
-      fail(where, "offset frames refer to each other in a cycle (via " + quote_token(path) +
+      fail(where, "offset frames refer to each other in a cycle (via " + quote_for_message(path) +
                       "); each PhysicalOffsetFrame must end at a body");
     }
     const std::vector<std::string_view> segments = split_path(path);
     if (segments.empty()) {
-      fail(where, "names no frame (" + quote_token(path) +
+      fail(where, "names no frame (" + quote_for_message(path) +
                       "); expected a frame path such as /bodyset/femur_r");
     }
     const std::string name(segments.back());
@@ -597,8 +558,8 @@ class OsimReader {
     const OffsetFrameEntry* entry = nullptr;
     if (scope == "bodyset") {
       if (!body_names_.contains(name)) {
-        fail(where, "refers to " + quote_token(path) + ", but the model has no body " +
-                        quote_token(name) + "; " + known_bodies());
+        fail(where, "refers to " + quote_for_message(path) + ", but the model has no body " +
+                        quote_for_message(name) + "; " + known_bodies());
       }
       return body_frame(name);
     }
@@ -615,7 +576,7 @@ class OsimReader {
       if (entry == nullptr) entry = unique_offset_frame(where, name);
     }
     if (entry == nullptr) {
-      fail(where, "refers to frame " + quote_token(path) +
+      fail(where, "refers to frame " + quote_for_message(path) +
                       ", which is neither a body nor a PhysicalOffsetFrame of the model; " +
                       known_bodies());
     }
@@ -623,7 +584,8 @@ class OsimReader {
                                         "expected the path of the frame it is offset from");
     const std::string_view joint_scope =
         entry->scope == Scope::kJoint ? std::string_view(entry->owner) : std::string_view();
-    const FrameRef parent = resolve_frame(socket, trim(text_of(socket)), joint_scope, depth + 1);
+    const FrameRef parent =
+        resolve_frame(socket, trim_xml_space(text_of(socket)), joint_scope, depth + 1);
     const Eigen::Vector3d translation =
         vec3_or(*entry->element, "translation", Eigen::Vector3d::Zero());
     const Eigen::Vector3d orientation =
@@ -655,7 +617,7 @@ class OsimReader {
     for (const OffsetFrameEntry& entry : offset_frames_) {
       if (entry.name != name) continue;
       if (found != nullptr) {
-        fail(where, "frame name " + quote_token(name) + " is ambiguous (owned by both '" +
+        fail(where, "frame name " + quote_for_message(name) + " is ambiguous (owned by both '" +
                         found->owner + "' and '" + entry.owner +
                         "'); use the full path, e.g. /jointset/" + entry.owner + "/" + name);
       }
@@ -668,7 +630,7 @@ class OsimReader {
                         std::string_view context_joint) const {
     const XMLElement& element =
         required(owner, socket, "expected the path of its frame, e.g. /bodyset/femur_r");
-    return resolve_frame(element, trim(text_of(element)), context_joint, 0);
+    return resolve_frame(element, trim_xml_space(text_of(element)), context_joint, 0);
   }
 
   // Frame of a path point or marker: 4.x socket_parent_frame, 3.x <body>.
@@ -677,7 +639,7 @@ class OsimReader {
       return socket_frame(element, "socket_parent_frame", "");
     }
     const XMLElement& body = required(element, "body", "expected the name of its body");
-    return body_frame_3(body, std::string(trim(text_of(body))));
+    return body_frame_3(body, std::string(trim_xml_space(text_of(body))));
   }
 
   // ------------------------------------------------------------ joints
@@ -695,7 +657,7 @@ class OsimReader {
     coordinate.clamped = boolean_or(element, "clamped", false);
     coordinate.locked = boolean_or(element, "locked", false);
     if (const XMLElement* motion = element.FirstChildElement("motion_type")) {
-      const std::string type = lower(trim(text_of(*motion)));
+      const std::string type = ascii_lower(trim_xml_space(text_of(*motion)));
       if (type == "rotational") {
         coordinate.motion_type = MotionType::kRotational;
       } else if (type == "translational") {
@@ -703,8 +665,8 @@ class OsimReader {
       } else if (type == "coupled") {
         coordinate.motion_type = MotionType::kCoupled;
       } else {
-        fail(*motion,
-             "holds " + quote_token(type) + ", expected rotational, translational or coupled");
+        fail(*motion, "holds " + quote_for_message(type) +
+                          ", expected rotational, translational or coupled");
       }
       explicit_motion_types_.insert(coordinate.name);
     }
@@ -757,8 +719,8 @@ class OsimReader {
       if (inner == nullptr) fail(wrapper, "is empty; expected one function element inside");
       return MultiplierFunction(read_function(*inner), scalar_or(element, "scale", 1.0));
     }
-    fail(element, "function type " + quote_token(tag) + " is not supported; expected one of " +
-                      std::string(kSupportedFunctions) +
+    fail(element, "function type " + quote_for_message(tag) +
+                      " is not supported; expected one of " + std::string(kSupportedFunctions) +
                       " (hint: refit the curve as a SimmSpline in OpenSim)");
   }
 
@@ -789,7 +751,7 @@ class OsimReader {
       TransformAxis transform_axis;
       transform_axis.name = name_of(*axis);
       const std::string coordinate_list = text_or(*axis, "coordinates");
-      for (const std::string_view word : split_words(coordinate_list)) {
+      for (const std::string_view word : split_xml_words(coordinate_list)) {
         transform_axis.coordinates.emplace_back(word);
       }
       transform_axis.axis = vec3(required(*axis, "axis", "expected the axis direction 'x y z'"));
@@ -900,9 +862,9 @@ class OsimReader {
   // ------------------------------------------------------------ forces
 
   std::string coordinate_reference(const XMLElement& element) const {
-    std::string name = last_segment(trim(text_of(element)));
+    std::string name = last_segment(trim_xml_space(text_of(element)));
     if (!coordinate_names_.contains(name)) {
-      fail(element, "refers to coordinate " + quote_token(trim(text_of(element))) +
+      fail(element, "refers to coordinate " + quote_for_message(trim_xml_space(text_of(element))) +
                         ", which no joint of the model defines");
     }
     return name;
@@ -979,9 +941,9 @@ class OsimReader {
       wrap.name = name_of(element);
       const XMLElement& object =
           required(element, "wrap_object", "expected the name of a wrap object of a body");
-      wrap.wrap_object = std::string(trim(text_of(object)));
+      wrap.wrap_object = std::string(trim_xml_space(text_of(object)));
       if (model_.find_wrap_object(wrap.wrap_object) == nullptr) {
-        fail(object, "refers to wrap object " + quote_token(wrap.wrap_object) +
+        fail(object, "refers to wrap object " + quote_for_message(wrap.wrap_object) +
                          ", which no body's WrapObjectSet defines");
       }
       const std::string method = text_or(element, "method");

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/opensim/text_parsing.h"
 
 namespace mmm::opensim {
 
@@ -24,42 +25,9 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Header lines before the data: PathFileType, keys, values, names, X/Y/Z labels.
 constexpr int kHeaderLines = 5;
-constexpr std::size_t kMaxShown = 40;
-constexpr int kMaxDecimals = 20;
+constexpr int kMaxTrcDecimals = 20;
 
-struct Line {
-  std::string_view text;
-  int number = 0;  // 1-based
-};
-
-// Lines of `text`, split at LF, CRLF or a lone CR, without the line ends. A
-// leading UTF-8 byte order mark is dropped.
-std::vector<Line> split_lines(std::string_view text) {
-  constexpr std::string_view kBom = "\xEF\xBB\xBF";
-  if (text.substr(0, kBom.size()) == kBom) text.remove_prefix(kBom.size());
-  std::vector<Line> lines;
-  std::size_t start = 0;
-  int number = 1;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (c != '\n' && c != '\r') continue;
-    lines.push_back({text.substr(start, i - start), number++});
-    if (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
-    start = i + 1;
-  }
-  if (start < text.size()) lines.push_back({text.substr(start), number});
-  return lines;
-}
-
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
-
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && is_blank(text.front())) text.remove_prefix(1);
-  while (!text.empty() && is_blank(text.back())) text.remove_suffix(1);
-  return text;
-}
-
-bool is_blank_line(std::string_view line) { return trim(line).empty(); }
+bool is_blank_line(std::string_view line) { return trim_line_blanks(line).empty(); }
 
 // Fields of a line: at tabs when the line has one (an empty field is kept,
 // it marks a missing value), otherwise at runs of spaces. Fields are trimmed.
@@ -70,7 +38,7 @@ void split_fields(std::string_view line, std::vector<std::string_view>& fields) 
     while (true) {
       const std::size_t tab = line.find('\t', start);
       const std::size_t end = tab == std::string_view::npos ? line.size() : tab;
-      fields.push_back(trim(line.substr(start, end - start)));
+      fields.push_back(trim_line_blanks(line.substr(start, end - start)));
       if (tab == std::string_view::npos) break;
       start = tab + 1;
     }
@@ -78,9 +46,9 @@ void split_fields(std::string_view line, std::vector<std::string_view>& fields) 
   }
   std::size_t pos = 0;
   while (pos < line.size()) {
-    while (pos < line.size() && is_blank(line[pos])) ++pos;
+    while (pos < line.size() && is_line_blank(line[pos])) ++pos;
     const std::size_t start = pos;
-    while (pos < line.size() && !is_blank(line[pos])) ++pos;
+    while (pos < line.size() && !is_line_blank(line[pos])) ++pos;
     if (pos > start) fields.push_back(line.substr(start, pos - start));
   }
 }
@@ -95,71 +63,19 @@ std::vector<std::string_view> header_fields(std::string_view line) {
   return fields;
 }
 
-bool parse_double(std::string_view token, double& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return false;
-  const char* end = token.data() + token.size();
-  const auto [ptr, error] = std::from_chars(token.data(), end, value);
-  return error == std::errc() && ptr == end;
-}
-
-bool parse_int(std::string_view token, int& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return false;
-  const char* end = token.data() + token.size();
-  const auto [ptr, error] = std::from_chars(token.data(), end, value);
-  return error == std::errc() && ptr == end;
-}
-
-std::string quote(std::string_view text) {
-  if (text.size() > kMaxShown) return "'" + std::string(text.substr(0, kMaxShown)) + "...'";
-  return "'" + std::string(text) + "'";
-}
-
-std::string lower(std::string_view text) {
-  std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](char c) {
-    return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
-  });
-  return out;
-}
-
-std::string format_double(double value) {
-  std::array<char, 64> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return {buffer.data(), result.ptr};
-}
-
 // Millimetres per unit for the spellings of mm, cm and m; nullopt otherwise.
 std::optional<double> millimetres_per_unit(std::string_view units) {
-  const std::string key = lower(units);
+  const std::string key = ascii_lower(units);
   if (key == "mm" || key == "millimeters" || key == "millimetres") return 1.0;
   if (key == "cm" || key == "centimeters" || key == "centimetres") return 10.0;
   if (key == "m" || key == "meters" || key == "metres") return 1000.0;
   return std::nullopt;
 }
 
-std::string read_whole_file(const std::filesystem::path& file) {
-  std::error_code error;
-  if (!std::filesystem::exists(file, error)) {
-    throw IoError(file, "no such file; check the path (relative paths are taken from " +
-                            std::filesystem::current_path(error).string() + ")");
-  }
-  if (std::filesystem::is_directory(file, error)) {
-    throw IoError(file, "is a folder, expected a .trc file");
-  }
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw IoError(file, "cannot be opened for reading (permissions?)");
-  std::ostringstream content;
-  content << in.rdbuf();
-  if (in.bad()) throw IoError(file, "read failed part-way (I/O error)");
-  return std::move(content).str();
-}
-
 class TrcParser {
  public:
   TrcParser(std::string_view text, std::filesystem::path name)
-      : name_(std::move(name)), lines_(split_lines(text)) {}
+      : name_(std::move(name)), lines_(split_text_lines(text)) {}
 
   MarkerTrajectories parse() {
     out_.source = name_;
@@ -177,12 +93,12 @@ class TrcParser {
     throw IoError(name_, "line " + std::to_string(line) + ": " + problem);
   }
   [[noreturn]] void fail(int line, std::string_view column, const std::string& problem) const {
-    throw IoError(name_,
-                  "line " + std::to_string(line) + ", column " + quote(column) + ": " + problem);
+    throw IoError(name_, "line " + std::to_string(line) + ", column " + quote_for_message(column) +
+                             ": " + problem);
   }
 
   // Header line `index` (1-based); fails when the file ends before it.
-  const Line& header_line(int index, std::string_view expected) const {
+  const TextLine& header_line(int index, std::string_view expected) const {
     if (static_cast<int>(lines_.size()) < index) {
       fail(index, "the file ends before header line " + std::to_string(index) + " (" +
                       std::string(expected) + "); a .trc file has 5 header lines before the data");
@@ -197,14 +113,14 @@ class TrcParser {
     const std::vector<std::string_view> fields = header_fields(lines_[0].text);
     if (fields.empty() || fields[0] != "PathFileType") {
       fail(1, "expected 'PathFileType' as the first word of a .trc file, got " +
-                  (fields.empty() ? std::string("an empty line") : quote(fields[0])) +
+                  (fields.empty() ? std::string("an empty line") : quote_for_message(fields[0])) +
                   "; hint: is this a .trc file (a .mot/.sto or C3D file needs another reader)?");
     }
   }
 
   void parse_keys_and_values() {
-    const Line& key_line = header_line(2, "DataRate CameraRate NumFrames NumMarkers Units ...");
-    const Line& value_line = header_line(3, "the values of the header keys");
+    const TextLine& key_line = header_line(2, "DataRate CameraRate NumFrames NumMarkers Units ...");
+    const TextLine& value_line = header_line(3, "the values of the header keys");
     const std::vector<std::string_view> keys = header_fields(key_line.text);
     const std::vector<std::string_view> values = header_fields(value_line.text);
     if (keys.size() != values.size()) {
@@ -219,7 +135,7 @@ class TrcParser {
     bool has_orig_frames = false;
     std::set<std::string> seen;
     for (std::size_t i = 0; i < keys.size(); ++i) {
-      const std::string key = lower(keys[i]);
+      const std::string key = ascii_lower(keys[i]);
       const std::string_view value = values[i];
       if (!seen.insert(key).second) {
         fail(key_line.number, keys[i], "the header key appears twice; expected each key once");
@@ -246,13 +162,13 @@ class TrcParser {
         const std::optional<double> factor = millimetres_per_unit(value);
         if (!factor) {
           fail(value_line.number, keys[i],
-               "unknown length unit " + quote(value) + ", expected mm, cm or m");
+               "unknown length unit " + quote_for_message(value) + ", expected mm, cm or m");
         }
         out_.units = std::string(value);
         out_.unit_to_mm = *factor;
       } else {
         out_.warnings.push_back("line " + std::to_string(key_line.number) +
-                                ": unknown header key " + quote(keys[i]) + " ignored");
+                                ": unknown header key " + quote_for_message(keys[i]) + " ignored");
       }
     }
     for (const auto* required : {"datarate", "numframes", "nummarkers", "units"}) {
@@ -270,32 +186,34 @@ class TrcParser {
 
   double header_rate(int line, std::string_view key, std::string_view value) const {
     double rate = 0.0;
-    if (!parse_double(value, rate) || !std::isfinite(rate) || rate <= 0.0) {
-      fail(line, key, "expected a positive rate in Hz, got " + quote(value));
+    if (!parse_double_token(value, rate) || !std::isfinite(rate) || rate <= 0.0) {
+      fail(line, key, "expected a positive rate in Hz, got " + quote_for_message(value));
     }
     return rate;
   }
 
   int header_integer(int line, std::string_view key, std::string_view value) const {
     int number = 0;
-    if (!parse_int(value, number)) fail(line, key, "expected an integer, got " + quote(value));
+    if (!parse_int_token(value, number))
+      fail(line, key, "expected an integer, got " + quote_for_message(value));
     return number;
   }
 
   int header_count(int line, std::string_view key, std::string_view value) const {
     const int count = header_integer(line, key, value);
-    if (count < 0) fail(line, key, "expected a count >= 0, got " + quote(value));
+    if (count < 0) fail(line, key, "expected a count >= 0, got " + quote_for_message(value));
     return count;
   }
 
   void parse_names() {
-    const Line& line = header_line(4, "Frame# Time and the marker names");
+    const TextLine& line = header_line(4, "Frame# Time and the marker names");
     const std::vector<std::string_view> fields = header_fields(line.text);
-    if (fields.size() < 2 || lower(fields[0]) != "frame#" || lower(fields[1]) != "time") {
+    if (fields.size() < 2 || ascii_lower(fields[0]) != "frame#" ||
+        ascii_lower(fields[1]) != "time") {
       fail(line.number,
            "expected the column labels 'Frame#' and 'Time' followed by the marker "
            "names, got " +
-               (fields.empty() ? std::string("an empty line") : quote(line.text)));
+               (fields.empty() ? std::string("an empty line") : quote_for_message(line.text)));
     }
     const auto num_names = static_cast<int>(fields.size()) - 2;
     if (num_names != header_num_markers_) {
@@ -318,7 +236,7 @@ class TrcParser {
   }
 
   void parse_coordinate_labels() {
-    const Line& line = header_line(kHeaderLines, "the X1 Y1 Z1 X2 ... coordinate labels");
+    const TextLine& line = header_line(kHeaderLines, "the X1 Y1 Z1 X2 ... coordinate labels");
     const std::vector<std::string_view> fields = header_fields(line.text);
     const std::size_t expected = 3 * out_.marker_names.size();
     if (fields.size() != expected) {
@@ -335,9 +253,10 @@ class TrcParser {
     if (column < 2) fail(line, column == 0 ? "Frame#" : "Time", problem);
     const std::size_t coordinate = column - 2;
     const std::size_t marker = coordinate / 3;
-    std::string where = "column " + quote(coordinate < labels_.size() ? labels_[coordinate] : "?");
+    std::string where =
+        "column " + quote_for_message(coordinate < labels_.size() ? labels_[coordinate] : "?");
     if (marker < out_.marker_names.size())
-      where += " (marker " + quote(out_.marker_names[marker]) + ")";
+      where += " (marker " + quote_for_message(out_.marker_names[marker]) + ")";
     throw IoError(name_, "line " + std::to_string(line) + ", " + where + ": " + problem);
   }
 
@@ -348,7 +267,7 @@ class TrcParser {
     int previous_line = 0;
     double previous_time = 0.0;
     for (std::size_t l = kHeaderLines; l < lines_.size(); ++l) {
-      const Line& line = lines_[l];
+      const TextLine& line = lines_[l];
       if (is_blank_line(line.text)) continue;
       split_fields(line.text, fields);
       while (fields.size() > num_columns && fields.back().empty()) fields.pop_back();
@@ -364,8 +283,8 @@ class TrcParser {
       const double time = parse_time(line.number, fields);
       if (previous_line > 0 && !(time > previous_time)) {
         fail(line.number, "Time",
-             "time " + format_double(time) + " s does not increase, expected more than " +
-                 format_double(previous_time) + " s (line " + std::to_string(previous_line) +
+             "time " + shortest_double_text(time) + " s does not increase, expected more than " +
+                 shortest_double_text(previous_time) + " s (line " + std::to_string(previous_line) +
                  "); hint: duplicated or unsorted frames");
       }
       previous_line = line.number;
@@ -380,15 +299,15 @@ class TrcParser {
             missing = true;
             continue;
           }
-          if (!parse_double(fields[column], xyz[a])) {
+          if (!parse_double_token(fields[column], xyz[a])) {
             fail_column(line.number, column,
                         "expected a number or an empty field (missing marker), got " +
-                            quote(fields[column]));
+                            quote_for_message(fields[column]));
           }
           if (std::isinf(xyz[a])) {
-            fail_column(
-                line.number, column,
-                "expected a finite coordinate or an empty field, got " + quote(fields[column]));
+            fail_column(line.number, column,
+                        "expected a finite coordinate or an empty field, got " +
+                            quote_for_message(fields[column]));
           }
           if (std::isnan(xyz[a])) missing = true;
         }
@@ -406,8 +325,8 @@ class TrcParser {
       fail(line, "Frame#", "the frame number is missing, expected an integer");
     }
     int frame = 0;
-    if (!parse_int(fields[0], frame)) {
-      fail(line, "Frame#", "expected an integer frame number, got " + quote(fields[0]));
+    if (!parse_int_token(fields[0], frame)) {
+      fail(line, "Frame#", "expected an integer frame number, got " + quote_for_message(fields[0]));
     }
     return frame;
   }
@@ -417,11 +336,11 @@ class TrcParser {
       fail(line, "Time", "the time is missing, expected a number of seconds");
     }
     double time = 0.0;
-    if (!parse_double(fields[1], time)) {
-      fail(line, "Time", "expected a number of seconds, got " + quote(fields[1]));
+    if (!parse_double_token(fields[1], time)) {
+      fail(line, "Time", "expected a number of seconds, got " + quote_for_message(fields[1]));
     }
     if (!std::isfinite(time)) {
-      fail(line, "Time", "expected a finite time, got " + quote(fields[1]));
+      fail(line, "Time", "expected a finite time, got " + quote_for_message(fields[1]));
     }
     return time;
   }
@@ -447,7 +366,7 @@ class TrcParser {
   }
 
   std::filesystem::path name_;
-  std::vector<Line> lines_;
+  std::vector<TextLine> lines_;
   MarkerTrajectories out_;
   int header_num_frames_ = 0;
   int header_num_markers_ = 0;
@@ -460,24 +379,13 @@ class TrcParser {
   int short_rows_ = 0;
 };
 
-void append_number(std::string& out, double value, int decimals) {
-  // Fixed notation of the largest double needs 309 digits before the point.
-  std::array<char, 400> buffer{};
-  char* const first = buffer.data();
-  char* const last = buffer.data() + buffer.size();
-  const std::to_chars_result result =
-      decimals < 0 ? std::to_chars(first, last, value)
-                   : std::to_chars(first, last, value, std::chars_format::fixed, decimals);
-  out.append(first, result.ptr);
-}
-
 void check_for_writing(const MarkerTrajectories& t, const TrcWriteOptions& options) {
   const auto fail = [](const std::string& problem) {
     throw InvalidInputError("write_trc: " + problem);
   };
-  if (options.decimals > kMaxDecimals) {
+  if (options.decimals > kMaxTrcDecimals) {
     fail("decimals " + std::to_string(options.decimals) + " exceeds " +
-         std::to_string(kMaxDecimals) + "; use a negative value for exact round trips");
+         std::to_string(kMaxTrcDecimals) + "; use a negative value for exact round trips");
   }
   const Eigen::Index num_frames = t.times.size();
   const Eigen::Index num_markers = t.num_markers();
@@ -491,23 +399,25 @@ void check_for_writing(const MarkerTrajectories& t, const TrcWriteOptions& optio
          std::to_string(num_frames) + " (one per time)");
   }
   if (!std::isfinite(t.data_rate) || t.data_rate <= 0.0) {
-    fail("data_rate " + format_double(t.data_rate) + " Hz is not a positive number");
+    fail("data_rate " + shortest_double_text(t.data_rate) + " Hz is not a positive number");
   }
   if (!millimetres_per_unit(t.units)) {
-    fail("units " + quote(t.units) + " is not one of mm, cm, m");
+    fail("units " + quote_for_message(t.units) + " is not one of mm, cm, m");
   }
   std::set<std::string_view> seen;
   for (const std::string& name : t.marker_names) {
-    if (name.empty() || name.find_first_of("\t\r\n") != std::string::npos || trim(name) != name) {
-      fail("marker name " + quote(name) +
+    if (name.empty() || name.find_first_of("\t\r\n") != std::string::npos ||
+        trim_line_blanks(name) != name) {
+      fail("marker name " + quote_for_message(name) +
            " is empty, has surrounding blanks or contains a tab or line break");
     }
-    if (!seen.insert(name).second) fail("marker name " + quote(name) + " appears twice");
+    if (!seen.insert(name).second)
+      fail("marker name " + quote_for_message(name) + " appears twice");
   }
   for (Eigen::Index f = 0; f < num_frames; ++f) {
     if (!std::isfinite(t.times(f)) || (f > 0 && !(t.times(f) > t.times(f - 1)))) {
       fail("times must be finite and strictly increasing; frame " + std::to_string(f) + " has " +
-           format_double(t.times(f)) + " s");
+           shortest_double_text(t.times(f)) + " s");
     }
   }
   if (t.positions.array().isInf().any()) fail("positions contain an infinite value");
@@ -555,7 +465,7 @@ Eigen::Index MarkerTrajectories::count_missing() const {
 }
 
 MarkerTrajectories read_trc(const std::filesystem::path& file) {
-  return parse_trc(read_whole_file(file), file);
+  return parse_trc(read_whole_text_file(file, "a .trc file"), file);
 }
 
 MarkerTrajectories parse_trc(std::string_view text,
@@ -577,9 +487,9 @@ void write_trc(const MarkerTrajectories& trajectories, const std::filesystem::pa
       "\tOrigNumFrames\n";
   const double camera_rate = t.camera_rate > 0.0 ? t.camera_rate : t.data_rate;
   const double orig_rate = t.orig_data_rate > 0.0 ? t.orig_data_rate : t.data_rate;
-  out += format_double(t.data_rate) + "\t" + format_double(camera_rate) + "\t" +
+  out += shortest_double_text(t.data_rate) + "\t" + shortest_double_text(camera_rate) + "\t" +
          std::to_string(num_frames) + "\t" + std::to_string(num_markers) + "\t" + t.units + "\t" +
-         format_double(orig_rate) + "\t" + std::to_string(t.orig_data_start_frame) + "\t" +
+         shortest_double_text(orig_rate) + "\t" + std::to_string(t.orig_data_start_frame) + "\t" +
          std::to_string(t.orig_num_frames > 0 ? t.orig_num_frames : num_frames) + "\n";
   out += "Frame#\tTime";
   for (const std::string& name : t.marker_names) out += "\t" + name + "\t\t";
@@ -596,11 +506,11 @@ void write_trc(const MarkerTrajectories& trajectories, const std::filesystem::pa
   for (Eigen::Index f = 0; f < num_frames; ++f) {
     out += std::to_string(t.frame_numbers[static_cast<std::size_t>(f)]);
     out += '\t';
-    append_number(out, t.times(f), options.decimals);
+    append_number_text(out, t.times(f), options.decimals);
     for (Eigen::Index c = 0; c < 3 * num_markers; ++c) {
       out += '\t';
       const double value = t.positions(f, c);
-      if (!std::isnan(value)) append_number(out, value, options.decimals);
+      if (!std::isnan(value)) append_number_text(out, value, options.decimals);
     }
     out += '\n';
   }

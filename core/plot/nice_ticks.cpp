@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "core/errors.h"
+#include "core/plot/shortest_text.h"
 
 namespace mmm::plot {
 
@@ -44,13 +45,7 @@ std::string format(double value, std::chars_format style, int precision) {
   return trim_zeros(std::string_view(buffer.data(), static_cast<std::size_t>(end - buffer.data())));
 }
 
-// Any double in the shortest form that reads back exactly, for messages.
-std::string shortest(double value) {
-  std::array<char, 32> buffer{};
-  const auto [end, error] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  if (error != std::errc{}) return "?";
-  return {buffer.data(), end};
-}
+using detail::shortest;
 
 // The tick k * m * 10^e, computed so that decimal ticks come out as the
 // doubles nearest them: k * m is exact, and dividing by an exact power of ten

@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "core/file_bytes.h"
 #include "core/plot/nice_ticks.h"
+#include "core/plot/shortest_text.h"
 #include "core/xml_escape.h"
 
 namespace mmm::plot {
@@ -60,13 +61,7 @@ std::string px(double value) {
   return text == "-0" ? "0" : text;
 }
 
-// Any double in the shortest form that reads back exactly, for messages.
-std::string shortest(double value) {
-  std::array<char, 32> buffer{};
-  const auto [end, error] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  if (error != std::errc{}) return "?";
-  return {buffer.data(), end};
-}
+using detail::shortest;
 
 // --- XML (text escaped by core/xml_escape.h) ---------------------------
 

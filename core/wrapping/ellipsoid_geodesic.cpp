@@ -8,10 +8,13 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/wrapping/path_pieces.h"
 
 namespace mmm::wrapping {
 namespace {
 
+using detail::polyline_length;
+using detail::straight;
 using Eigen::Vector3d;
 
 // Points on the wrapped part: at least / at most this many.
@@ -175,20 +178,6 @@ class OnPlane final : public ceres::SizedCostFunction<1, kSize> {
   Vector3d normal_;
   const TangentCircle* circle_;
 };
-
-WrapResult straight(const Vector3d& p, const Vector3d& s, bool inside) {
-  WrapResult result;
-  result.inside = inside;
-  result.length = (s - p).norm();
-  result.points = {p, s};
-  return result;
-}
-
-double polyline_length(const std::vector<Vector3d>& points) {
-  double length = 0.0;
-  for (std::size_t i = 1; i < points.size(); ++i) length += (points[i] - points[i - 1]).norm();
-  return length;
-}
 
 // `count` points evenly spaced by arc length along the polyline, its ends
 // included.

@@ -11,10 +11,12 @@
 #include <utility>
 
 #include "core/errors.h"
+#include "core/wrapping/path_pieces.h"
 
 namespace mmm::wrapping {
 namespace {
 
+using detail::polyline_length;
 using Eigen::Vector3d;
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
@@ -324,12 +326,6 @@ class OffsetSurface final : public ceres::Manifold {
   mutable Vector3d cached_at_ = Vector3d::Zero();
   mutable Basis cached_basis_ = Basis::Zero();
 };
-
-double polyline_length(std::span<const Vector3d> points) {
-  double length = 0.0;
-  for (std::size_t i = 1; i < points.size(); ++i) length += (points[i] - points[i - 1]).norm();
-  return length;
-}
 
 // `count` points evenly spaced by arc length strictly inside the polyline.
 std::vector<Vector3d> resample_interior(std::span<const Vector3d> polyline, int count) {

@@ -12,10 +12,12 @@
 #include "core/errors.h"
 #include "core/parallel_for.h"
 #include "core/scaling/sparse_cholesky.h"
+#include "core/wrapping/deformer_math.h"
 
 namespace mmm::wrapping {
 namespace {
 
+using detail::frobenius_dot;
 using Eigen::MatrixX3d;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -70,10 +72,6 @@ void check(const std::vector<JointBody>& bodies, const JointOptions& options) {
         throw InvalidInputError(which + ": a contact is out of range or not finite");
     }
   }
-}
-
-double frobenius_dot(const MatrixX3d& a, const MatrixX3d& b) {
-  return (a.array() * b.array()).sum();
 }
 
 // A group's volume steps (one solve with a column per body and coordinate

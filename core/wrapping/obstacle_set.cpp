@@ -5,9 +5,12 @@
 
 #include "core/errors.h"
 #include "core/wrapping/ellipsoid_geodesic.h"
+#include "core/wrapping/path_pieces.h"
 
 namespace mmm::wrapping {
 namespace {
+
+using detail::straight;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
@@ -69,14 +72,6 @@ const CircleWrap& choose(const CircleWrap& ccw, const CircleWrap& cw, const Quad
                          MidpointSide midpoint_side) {
   if (quadrant.axis < 0) return std::abs(ccw.sweep) <= std::abs(cw.sweep) ? ccw : cw;
   return midpoint_side(ccw) >= midpoint_side(cw) ? ccw : cw;
-}
-
-WrapResult straight(const Eigen::Vector3d& p, const Eigen::Vector3d& s, bool inside) {
-  WrapResult result;
-  result.inside = inside;
-  result.length = (s - p).norm();
-  result.points = {p, s};
-  return result;
 }
 
 int arc_steps(double arc_length, double step) {

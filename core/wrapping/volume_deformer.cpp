@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "core/mesh/laplacian.h"
 #include "core/scaling/sparse_cholesky.h"
+#include "core/wrapping/deformer_math.h"
 
 namespace mmm::wrapping {
 namespace {
@@ -16,6 +17,7 @@ namespace {
 using Eigen::MatrixX3d;
 using Eigen::MatrixXd;
 using SparseMatrix = Eigen::SparseMatrix<double>;
+using detail::frobenius_dot;
 
 void check_options(const DeformerOptions& options) {
   const bool valid = options.stiffness_length_mm > 0 &&
@@ -37,10 +39,6 @@ double mean_edge_length(const mesh::IndexedMesh& mesh) {
     }
   }
   return sum / static_cast<double>(3 * mesh.F.rows());
-}
-
-double frobenius_dot(const MatrixX3d& a, const MatrixX3d& b) {
-  return (a.array() * b.array()).sum();
 }
 
 }  // namespace

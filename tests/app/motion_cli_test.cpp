@@ -20,17 +20,16 @@ namespace fs = std::filesystem;
 using test::CommandResult;
 using test::run_mmm;
 
-fs::path pipelines() { return test::data_dir() / "gait2392" / "Pipelines"; }
-
 TEST(MotionCliTest, TheWalkThroughOpenSimsModelAgreesWithOpenSimAndIsExported) {
   test::ScratchDir dir("motion-cli");
   const fs::path study = dir / "walk";
   const CommandResult created = run_mmm(
       "study create " + study.string() + " -w " +
-      (test::source_dir() / "schemas/examples/motion_fusion.yaml").string() +
-      " --input model=" + (pipelines() / "reference" / "subject01_simbody.osim").string() +
-      " --input trial=" + (pipelines() / "subject01_walk1.trc").string() +
-      " --input reference=" + (pipelines() / "reference" / "subject01_walk1_ik.mot").string());
+      (test::source_dir() / "schemas/examples/motion_fusion.yaml").string() + " --input model=" +
+      (test::gait2392_pipelines() / "reference" / "subject01_simbody.osim").string() +
+      " --input trial=" + (test::gait2392_pipelines() / "subject01_walk1.trc").string() +
+      " --input reference=" +
+      (test::gait2392_pipelines() / "reference" / "subject01_walk1_ik.mot").string());
   ASSERT_EQ(created.exit_code, 0) << created.err;
   const CommandResult ran = run_mmm("run " + study.string() + " -q");
   ASSERT_EQ(ran.exit_code, 0) << ran.out << ran.err;

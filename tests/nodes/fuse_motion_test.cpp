@@ -25,8 +25,6 @@ namespace {
 
 using workflow::PortType;
 
-std::filesystem::path pipelines() { return mmm::test::data_dir() / "gait2392" / "Pipelines"; }
-
 workflow::ArtifactRef add_file(test::NodeHarness& harness, const std::filesystem::path& file) {
   return harness.add(PortType::kFile, mmm::test::read_text(file));
 }
@@ -185,9 +183,11 @@ TEST(FuseMotionNodeTest, SpecIsPinned) {
 TEST(FuseMotionNodeTest, DrivesOpenSimsSubjectModelAsOpenSimDoes) {
   test::NodeHarness harness;
   const auto outputs = harness.run<FuseMotion>(
-      {{"model", add_file(harness, pipelines() / "reference" / "subject01_simbody.osim")},
-       {"trial", add_file(harness, pipelines() / "subject01_walk1.trc")},
-       {"reference", add_file(harness, pipelines() / "reference" / "subject01_walk1_ik.mot")}},
+      {{"model", add_file(harness, mmm::test::gait2392_pipelines() / "reference" /
+                                       "subject01_simbody.osim")},
+       {"trial", add_file(harness, mmm::test::gait2392_pipelines() / "subject01_walk1.trc")},
+       {"reference", add_file(harness, mmm::test::gait2392_pipelines() / "reference" /
+                                           "subject01_walk1_ik.mot")}},
       {{"start_time", 0.5}, {"end_time", 1.0}, {"filter", std::string("none")}});
   const nlohmann::json report =
       nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
@@ -235,8 +235,9 @@ TEST(FuseMotionNodeTest, RetargetsTheSubjectsMotionToAPatientAtlas) {
   atlas::write_atlas_with_meshes(leg.atlas, leg.meshes, harness.folder() / "toy");
   const auto outputs = harness.run<FuseMotion>(
       {{"atlas", harness.add(PortType::kAtlas, pack_directory(harness.folder() / "toy"))},
-       {"model", add_file(harness, pipelines() / "reference" / "subject01_simbody.osim")},
-       {"trial", add_file(harness, pipelines() / "subject01_walk1.trc")}},
+       {"model", add_file(harness, mmm::test::gait2392_pipelines() / "reference" /
+                                       "subject01_simbody.osim")},
+       {"trial", add_file(harness, mmm::test::gait2392_pipelines() / "subject01_walk1.trc")}},
       {{"start_time", 0.5}, {"end_time", 0.7}, {"mesh_level", std::string("lod1")}});
   const nlohmann::json report =
       nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
@@ -257,7 +258,8 @@ TEST(FuseMotionNodeTest, RetargetsTheSubjectsMotionToAPatientAtlas) {
 TEST(FuseMotionNodeTest, NothingToDriveIsAnErrorWithAHint) {
   test::NodeHarness harness;
   try {
-    harness.run<FuseMotion>({{"trial", add_file(harness, pipelines() / "subject01_walk1.trc")}});
+    harness.run<FuseMotion>(
+        {{"trial", add_file(harness, mmm::test::gait2392_pipelines() / "subject01_walk1.trc")}});
     FAIL() << "ran without a model";
   } catch (const InvalidInputError& error) {
     EXPECT_NE(std::string(error.what()).find("connect 'atlas'"), std::string::npos);

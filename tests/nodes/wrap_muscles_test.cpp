@@ -28,8 +28,6 @@ namespace {
 
 using workflow::PortType;
 
-std::filesystem::path pipelines() { return mmm::test::data_dir() / "gait2392" / "Pipelines"; }
-
 // The toy leg with three pelvis markers (retargeting measures the patient
 // against the trial), written into the harness, and its motion over the
 // walk from 0.5 s to end_time.
@@ -99,9 +97,10 @@ ToyLegAndWalk toy_leg_and_walk(test::NodeHarness& harness, double end_time,
   result.atlas = harness.add(PortType::kAtlas, pack_directory(harness.folder() / "toy"));
   const auto fused = harness.run<FuseMotion>(
       {{"atlas", result.atlas},
-       {"model",
-        harness.add_file(PortType::kFile, pipelines() / "reference" / "subject01_simbody.osim")},
-       {"trial", harness.add_file(PortType::kFile, pipelines() / "subject01_walk1.trc")}},
+       {"model", harness.add_file(PortType::kFile, mmm::test::gait2392_pipelines() / "reference" /
+                                                       "subject01_simbody.osim")},
+       {"trial", harness.add_file(PortType::kFile,
+                                  mmm::test::gait2392_pipelines() / "subject01_walk1.trc")}},
       {{"start_time", 0.5}, {"end_time", end_time}});
   result.motion = fused.at("motion");
   return result;
@@ -334,9 +333,10 @@ TEST(WrapMusclesNodeTest, AMotionOfAnOpenSimModelIsRefusedWithAHint) {
   const mmm::test::ToyLeg leg = mmm::test::toy_leg();
   atlas::write_atlas_with_meshes(leg.atlas, leg.meshes, harness.folder() / "toy");
   const auto fused = harness.run<FuseMotion>(
-      {{"model",
-        harness.add_file(PortType::kFile, pipelines() / "reference" / "subject01_simbody.osim")},
-       {"trial", harness.add_file(PortType::kFile, pipelines() / "subject01_walk1.trc")}},
+      {{"model", harness.add_file(PortType::kFile, mmm::test::gait2392_pipelines() / "reference" /
+                                                       "subject01_simbody.osim")},
+       {"trial", harness.add_file(PortType::kFile,
+                                  mmm::test::gait2392_pipelines() / "subject01_walk1.trc")}},
       {{"start_time", 0.5}, {"end_time", 0.55}});
   try {
     harness.run<WrapMuscles>(

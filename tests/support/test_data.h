@@ -11,6 +11,13 @@ namespace mmm::test {
 // needs it fails (never skips) when it is missing: CI always has it beside us.
 std::filesystem::path data_dir();
 
+// OpenSim's gait2392 example under data_dir(): the generic model, and the
+// Pipelines folder of subject01's trials, setups and reference results.
+inline std::filesystem::path gait2392_model() {
+  return data_dir() / "gait2392" / "gait2392_thelen2003muscle.osim";
+}
+inline std::filesystem::path gait2392_pipelines() { return data_dir() / "gait2392" / "Pipelines"; }
+
 // The project's source and build folders.
 std::filesystem::path source_dir();
 std::filesystem::path binary_dir();

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <sstream>
 
+#include "workflow/definition/param_json.h"
+
 namespace mmm::workflow {
 namespace {
 
-nlohmann::json value_json(const ParamValue& value) {
-  return std::visit([](const auto& v) { return nlohmann::json(v); }, value);
-}
+using detail::value_json;
 
 // Shortest text that reads back as the same double: "1e-06", "0.1", "inf".
 std::string shortest_text(double value) { return param_value_text(value); }

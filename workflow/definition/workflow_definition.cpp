@@ -3,13 +3,12 @@
 #include <algorithm>
 
 #include "core/hash/sha256.h"
+#include "workflow/definition/param_json.h"
 
 namespace mmm::workflow {
 namespace {
 
-nlohmann::json value_json(const ParamValue& value) {
-  return std::visit([](const auto& v) { return nlohmann::json(v); }, value);
-}
+using detail::value_json;
 
 template <class T>
 const T* find_by(const std::vector<T>& items, std::string_view key, std::string T::*member) {

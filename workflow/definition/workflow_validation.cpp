@@ -46,7 +46,7 @@ bool default_fits(PortType type, const ParamValue& value) {
   }
 }
 
-std::string value_text(const ParamValue& value) {
+std::string typed_value_text(const ParamValue& value) {
   if (std::holds_alternative<std::string>(value)) return "string '" + param_value_text(value) + "'";
   if (std::holds_alternative<bool>(value)) return "boolean " + param_value_text(value);
   if (std::holds_alternative<std::int64_t>(value)) return "integer " + param_value_text(value);
@@ -95,7 +95,7 @@ class Checker {
       } else if (!default_fits(*input.type, *input.default_value)) {
         add(input.default_where, "default of study input '" + input.name + "' must be " +
                                      type_text(*input.type) + ", got " +
-                                     value_text(*input.default_value));
+                                     typed_value_text(*input.default_value));
       }
     }
   }

@@ -21,11 +21,12 @@
 #include "workflow/definition/yaml_scalar.h"
 
 namespace mmm::workflow {
-namespace {
+
+// The compiled form of a schema. Named, not file-local, because
+// YamlSchema::Compiled holds it.
+namespace schema_detail {
 
 using TypeMask = unsigned;
-
-TypeMask bit(YamlKind kind) { return 1U << static_cast<unsigned>(kind); }
 
 struct Pattern {
   std::string source;
@@ -63,6 +64,17 @@ struct Rule {
   std::vector<std::size_t> any_of;
   std::string description;
 };
+
+}  // namespace schema_detail
+
+namespace {
+
+using schema_detail::Literal;
+using schema_detail::Pattern;
+using schema_detail::Rule;
+using schema_detail::TypeMask;
+
+TypeMask bit(YamlKind kind) { return 1U << static_cast<unsigned>(kind); }
 
 bool is_numeric(YamlKind kind) { return kind == YamlKind::kInteger || kind == YamlKind::kNumber; }
 

@@ -15,6 +15,7 @@
 #include "core/errors.h"
 #include "core/hash/sha256.h"
 #include "workflow/fault_injection.h"
+#include "workflow/store/errno_text.h"
 
 namespace mmm::workflow {
 namespace {
@@ -25,9 +26,7 @@ constexpr std::size_t kCopyChunk = std::size_t{1} << 20;
 // Blobs are immutable once stored: read-only for everyone.
 constexpr mode_t kBlobMode = 0444;
 
-std::string errno_text(int code) {
-  return std::error_code(code, std::generic_category()).message();
-}
+using detail::errno_text;
 
 // Owns a POSIX file descriptor.
 class Fd {

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "workflow/host_and_time.h"
+#include "workflow/store/errno_text.h"
 
 namespace mmm::workflow {
 namespace {
@@ -19,9 +20,7 @@ namespace {
 constexpr const char* kLockFile = ".lock";
 constexpr std::chrono::milliseconds kRetryInterval{50};
 
-std::string errno_text(int code) {
-  return std::error_code(code, std::generic_category()).message();
-}
+using detail::errno_text;
 
 // Replaces the content of the locked file by the holder record. Informational
 // only: a failure here does not affect the lock, so it is not an error.

@@ -116,6 +116,11 @@ std::string little_endian_samples(const image::GrayImage16& image) {
   return bytes;
 }
 
+}  // namespace
+
+// Named, not file-local, because StationServer::Impl holds it.
+namespace station_detail {
+
 // Decoded views of the radiograph pairs already shown, by "<pair hash>/<view>"
 // (a few megabytes each: the oldest go when more than kCapacity are kept).
 class PixelCache {
@@ -154,14 +159,14 @@ class PixelCache {
   std::vector<std::pair<std::string, std::shared_ptr<const Pixels>>> entries_;
 };
 
-}  // namespace
+}  // namespace station_detail
 
 struct StationServer::Impl {
   ServerOptions options;
   const workflow::NodeRegistry& registry;
   httplib::Server server;
   int port = 0;
-  PixelCache pixels;
+  station_detail::PixelCache pixels;
   std::mutex log_mutex;
   std::unique_ptr<StudyResumer> resumer;
 
@@ -288,7 +293,7 @@ struct StationServer::Impl {
       throw NotFoundError("task " + entry.task.id + " has no view '" + view + "' with an image");
     }
     const workflow::Study study = workflow::Study::open(entry.study_dir, registry);
-    const std::shared_ptr<const PixelCache::Pixels> samples =
+    const std::shared_ptr<const station_detail::PixelCache::Pixels> samples =
         pixels.get(study, request["radiographs"].get<std::string>(), view);
     response.set_header("X-Image-Width", std::to_string(samples->width));
     response.set_header("X-Image-Height", std::to_string(samples->height));

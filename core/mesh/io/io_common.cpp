@@ -172,6 +172,8 @@ std::string describe_token(std::string_view token) {
   return "'" + shown + "'";
 }
 
+std::string at_line(int line) { return "line " + std::to_string(line) + ": "; }
+
 std::string to_lower(std::string_view text) {
   std::string lower(text);
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));

@@ -69,6 +69,9 @@ bool parse_int(std::string_view token, std::int64_t& value);
 // A token for an error message: quoted and shortened, or "end of file".
 std::string describe_token(std::string_view token);
 
+// "line 12: ", the prefix of a message about a text-format line (1-based).
+std::string at_line(int line);
+
 // Lower-case copy (ASCII).
 std::string to_lower(std::string_view text);
 

@@ -15,10 +15,9 @@ namespace mmm::mesh {
 
 namespace {
 
+using io_detail::at_line;
 using io_detail::describe_token;
 using io_detail::TextScanner;
-
-std::string at_line(int line) { return "line " + std::to_string(line) + ": "; }
 
 // Parses one face corner (v, v/vt, v/vt/vn or v//vn) into a 0-based index.
 int corner_index(const std::filesystem::path& path, std::string_view token, int line,

@@ -15,10 +15,9 @@ namespace mmm::mesh {
 
 namespace {
 
+using io_detail::at_line;
 using io_detail::describe_token;
 using io_detail::TextScanner;
-
-std::string at_line(int line) { return "line " + std::to_string(line) + ": "; }
 
 // OFF keywords: [ST][C][N][4][n]OFF. Returns false for tokens that are not a
 // keyword at all (the keyword is optional; the counts may come first).

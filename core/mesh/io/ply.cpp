@@ -17,6 +17,7 @@ namespace mmm::mesh {
 
 namespace {
 
+using io_detail::at_line;
 using io_detail::describe_token;
 using io_detail::TextScanner;
 
@@ -87,8 +88,6 @@ struct PlyHeader {
   std::size_t data_offset = 0;  // first byte after the end_header line
   int data_line = 1;            // line number of that byte (ASCII)
 };
-
-std::string at_line(int line) { return "line " + std::to_string(line) + ": "; }
 
 PlyType parse_type(const std::filesystem::path& path, std::string_view name, int line) {
   for (const auto& entry : kTypeNames) {

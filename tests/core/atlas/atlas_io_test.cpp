@@ -60,7 +60,7 @@ TransformAxis axis(bool rotation, const Eigen::Vector3d& direction, const std::s
   return a;
 }
 
-PathPoint point(const std::string& name, const std::string& bone, const Eigen::Vector3d& p) {
+PathPoint path_point(const std::string& name, const std::string& bone, const Eigen::Vector3d& p) {
   PathPoint result;
   result.name = name;
   result.bone = bone;
@@ -169,19 +169,20 @@ Atlas synthetic_atlas(const fs::path& dir) {
   ActionLine line;
   line.name = "vas_int_r";
   line.wrap_obstacles = {"knee_cylinder", "knee_sphere"};
-  PathPoint via = point("vas_int_r-P3", "femur_r", {80.5, 35.25, -430.125});
+  PathPoint via = path_point("vas_int_r-P3", "femur_r", {80.5, 35.25, -430.125});
   via.kind = PathPointKind::kConditional;
   via.coordinate = "knee_angle_r";
   via.range = {-2.6179938779914944, -1.4199999999999999};
-  PathPoint moving = point("vas_int_r-P4", "tibia_r", {80.0, 30.0, -460.0});
+  PathPoint moving = path_point("vas_int_r-P4", "tibia_r", {80.0, 30.0, -460.0});
   moving.kind = PathPointKind::kMoving;
   moving.moving_coordinates = {"knee_angle_r", "knee_angle_r", ""};
   moving.moving_functions = {
       opensim::SimmSpline({-2.0944, -1.0472, 0, 0.174533}, {9.0, 5.5, 3.3, 3.1}),
       opensim::PiecewiseLinearFunction({-2.0944, 0.0, 0.174533}, {-20.0, 0.1, 0.2}),
       opensim::PolynomialFunction{{1.5e-3, -2.0, 7.0}}};
-  line.points = {point("vas_int_r-P1", "femur_r", {82.0, 29.0, -300.0}),
-                 point("vas_int_r-P2", "femur_r", {std::sqrt(2.0), 1e-300, -1e20}), via, moving};
+  line.points = {path_point("vas_int_r-P1", "femur_r", {82.0, 29.0, -300.0}),
+                 path_point("vas_int_r-P2", "femur_r", {std::sqrt(2.0), 1e-300, -1e20}), via,
+                 moving};
   vastus.action_lines = {line};
 
   AttachmentArea origin;

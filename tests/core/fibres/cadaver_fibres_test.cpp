@@ -22,33 +22,34 @@ namespace {
 
 using Eigen::Vector3d;
 
-constexpr double kRadius = 15.0;
-constexpr double kLength = 100.0;
+constexpr double kMuscleRadius = 15.0;
+constexpr double kMuscleLength = 100.0;
 constexpr int kAround = 96;
 constexpr int kRings = 20;  // side bands of 5 mm
 // Largest gap between the circle and the 96-gon inscribed in it (mm).
-const double kSag = kRadius * (1.0 - std::cos(std::numbers::pi / kAround));
+const double kSag = kMuscleRadius * (1.0 - std::cos(std::numbers::pi / kAround));
 
 double degrees(double radians) { return radians * 180.0 / std::numbers::pi; }
 double angle_of(const Vector3d& p) { return degrees(std::atan2(p.y(), p.x())); }
 double radius_of(const Vector3d& p) { return p.head<2>().norm(); }
 
-// Closed cylinder around the z axis, z in [0, kLength]: kRings + 1 rings of
+// Closed cylinder around the z axis, z in [0, kMuscleLength]: kRings + 1 rings of
 // kAround vertices, fan caps, outward oriented. The two side faces of band
 // r (z in [5 r, 5 r + 5]) at middle angle a (degrees) are left out when
 // keep(r, a) is false.
 template <typename Keep>
-mesh::IndexedMesh cylinder(Keep keep) {
+mesh::IndexedMesh banded_cylinder(Keep keep) {
   std::vector<Vector3d> vertices;
   for (int r = 0; r <= kRings; ++r) {
     for (int k = 0; k < kAround; ++k) {
       const double a = 2.0 * std::numbers::pi * k / kAround;
-      vertices.emplace_back(kRadius * std::cos(a), kRadius * std::sin(a), kLength * r / kRings);
+      vertices.emplace_back(kMuscleRadius * std::cos(a), kMuscleRadius * std::sin(a),
+                            kMuscleLength * r / kRings);
     }
   }
   const int bottom = static_cast<int>(vertices.size());
   vertices.emplace_back(0, 0, 0);
-  vertices.emplace_back(0, 0, kLength);
+  vertices.emplace_back(0, 0, kMuscleLength);
   std::vector<Eigen::Vector3i> faces;
   for (int k = 0; k < kAround; ++k) {
     const int next = (k + 1) % kAround;
@@ -73,7 +74,7 @@ mesh::IndexedMesh cylinder(Keep keep) {
 }
 
 mesh::IndexedMesh closed_cylinder() {
-  return cylinder([](int, double) { return true; });
+  return banded_cylinder([](int, double) { return true; });
 }
 
 // A straight measured fibre at `angle` degrees on the true circle, from z =
@@ -83,7 +84,7 @@ Fibre measured_line(double angle) {
   Fibre fibre(5, 3);
   int i = 0;
   for (const double z : {10.0, 25.0, 40.0, 70.0, 90.0})
-    fibre.row(i++) << kRadius * std::cos(a), kRadius * std::sin(a), z;
+    fibre.row(i++) << kMuscleRadius * std::cos(a), kMuscleRadius * std::sin(a), z;
   return fibre;
 }
 
@@ -126,8 +127,8 @@ TEST(CadaverFibresTest, SurfaceFibresStayOnTheSurfaceAcrossTheMeasuredOnes) {
     for (Eigen::Index i = 0; i < fibre.rows(); ++i) {
       const Vector3d p = fibre.row(i).transpose();
       EXPECT_LT(tree.closest_point(p).squared_distance, 1e-18) << j << " " << i;  // projected
-      EXPECT_GE(radius_of(p), kRadius - kSag - 1e-9) << j << " " << i;            // on the 96-gon
-      EXPECT_LE(radius_of(p), kRadius + 1e-9) << j << " " << i;
+      EXPECT_GE(radius_of(p), kMuscleRadius - kSag - 1e-9) << j << " " << i;      // on the 96-gon
+      EXPECT_LE(radius_of(p), kMuscleRadius + 1e-9) << j << " " << i;
     }
     const double angle = angle_of(fibre.row(0).transpose());
     if (j > 0) {
@@ -162,7 +163,7 @@ TEST(CadaverFibresTest, DeeperFibresAreStraightAndReachTheOppositeSide) {
       worst_straight = std::max(worst_straight, off_axis_parallel(fibre));
       for (Eigen::Index i = 0; i < 21; ++i) {
         const Vector3d p = fibre.row(i).transpose();
-        EXPECT_LE(radius_of(p), kRadius + 1e-9) << j << " " << k << " " << i;
+        EXPECT_LE(radius_of(p), kMuscleRadius + 1e-9) << j << " " << k << " " << i;
         if (k > 0 && k < 8) lowest_winding = std::min(lowest_winding, winding.at(p));
         // Uniform along the chord: every layer one eighth of it further.
         const Vector3d step = (bottom.row(i) - top.row(i)).transpose() / 8.0;
@@ -193,7 +194,7 @@ TEST(CadaverFibresTest, DeeperFibresAreStraightAndReachTheOppositeSide) {
 TEST(CadaverFibresTest, RaysThroughAHoleMissAndBorrowTheirNeighboursDepth) {
   // No side faces for 40 < z < 60 between 180 and 330 degrees, where the
   // rays from the surface fibres (30 to 120 degrees) leave the muscle.
-  const mesh::IndexedMesh open = cylinder([](int band, double angle) {
+  const mesh::IndexedMesh open = banded_cylinder([](int band, double angle) {
     return !(band >= 8 && band < 12 && angle > 180 && angle < 330);
   });
   const CadaverFibreResult result = cadaver_fibres(open, four_lines());

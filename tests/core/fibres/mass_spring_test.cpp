@@ -28,7 +28,7 @@ using Eigen::Vector3d;
 // counter-clockwise seen from +z: with the origin at the lowest z, that is
 // counter-clockwise seen from the insertion end, and point 0 (+x) is where
 // the unit square's (1, 0.5) goes, so u runs along x and v along y.
-Contour circle(double radius, double z, int n, double cx = 0.0) {
+Contour circle_contour(double radius, double z, int n, double cx = 0.0) {
   Contour c(n, 3);
   for (int m = 0; m < n; ++m) {
     const double angle = 2.0 * std::numbers::pi * m / n;
@@ -37,9 +37,9 @@ Contour circle(double radius, double z, int n, double cx = 0.0) {
   return c;
 }
 
-std::vector<Contour> cylinder(int points) {
+std::vector<Contour> cylinder_contours(int points) {
   std::vector<Contour> layers;
-  for (int k = 0; k <= 10; ++k) layers.push_back(circle(10.0, 10.0 * k, points));
+  for (int k = 0; k <= 10; ++k) layers.push_back(circle_contour(10.0, 10.0 * k, points));
   return layers;
 }
 
@@ -121,7 +121,7 @@ TEST(MassSpringTest, FibresOfAStraightCylinderAreStraightAndSymmetric) {
   const int points = 64;
   const MassSpringOptions options;  // grid 9: 32 border fibres, on every other polygon vertex
   const int g = options.grid;
-  const MassSpringResult r = mass_spring_fibres(cylinder(points), options);
+  const MassSpringResult r = mass_spring_fibres(cylinder_contours(points), options);
   ASSERT_EQ(r.fibres.size(), 81U);
   double crooked = 0.0;
   double border_off = 0.0;
@@ -168,7 +168,7 @@ TEST(MassSpringTest, BorderFibresBetweenVerticesLieOnThePolygonsChords) {
   // that come as close as 10 cos(pi / 64) to the axis.
   MassSpringOptions options;
   options.grid = 8;
-  const std::vector<Contour> layers = cylinder(64);
+  const std::vector<Contour> layers = cylinder_contours(64);
   const MassSpringResult r = mass_spring_fibres(layers, options);
   const double inner = 10.0 * std::cos(std::numbers::pi / 64);
   for (int i = 0; i < 8; ++i) {
@@ -229,7 +229,7 @@ TEST(MassSpringTest, FibresOfATaperingFrustumStayInsideEveryContour) {
   for (const double flatten : {0.0, 0.5}) {
     std::vector<Contour> layers;
     for (int k = 0; k <= 12; ++k) {
-      Contour c = circle(20.0 - k, 5.0 * k, 48, 0.5 * k);
+      Contour c = circle_contour(20.0 - k, 5.0 * k, 48, 0.5 * k);
       c.col(1) *= 1.0 + flatten * k / 12.0;
       layers.push_back(c);
     }
@@ -264,18 +264,18 @@ TEST(MassSpringTest, FibresOfATaperingFrustumStayInsideEveryContour) {
 
 TEST(MassSpringTest, ConvergesAndReportsTheLastMove) {
   const MassSpringOptions options;
-  const MassSpringResult r = mass_spring_fibres(cylinder(64), options);
+  const MassSpringResult r = mass_spring_fibres(cylinder_contours(64), options);
   EXPECT_TRUE(r.converged);
   EXPECT_LE(r.largest_move_mm, options.tolerance_mm);
   // A Newton step on a quadratic energy: the first lands on the balance, the
   // second moves by rounding only.
   EXPECT_EQ(r.iterations, 2);
   EXPECT_LT(r.largest_move_mm, 1e-9);
-  EXPECT_LT(largest_imbalance(cylinder(64), r, options), 1e-9);
+  EXPECT_LT(largest_imbalance(cylinder_contours(64), r, options), 1e-9);
 
   MassSpringOptions once = options;
   once.max_iterations = 1;  // the move from the start (concentric rings) to the balance
-  const MassSpringResult first = mass_spring_fibres(cylinder(64), once);
+  const MassSpringResult first = mass_spring_fibres(cylinder_contours(64), once);
   EXPECT_FALSE(first.converged);
   EXPECT_EQ(first.iterations, 1);
   EXPECT_GT(first.largest_move_mm, 0.1);  // measured 1.25 mm
@@ -292,7 +292,7 @@ std::string refusal(const std::vector<Contour>& layers, const MassSpringOptions&
 }
 
 TEST(MassSpringTest, BadInputIsRefusedByName) {
-  const std::vector<Contour> good = cylinder(16);
+  const std::vector<Contour> good = cylinder_contours(16);
   const auto says = [](const std::string& message, const std::string& part) {
     EXPECT_NE(message.find(part), std::string::npos) << message;
   };

@@ -20,7 +20,7 @@ using Eigen::MatrixXd;
 using Eigen::Vector3d;
 
 // A straight fibre from a to b as a degree-1 t-polynomial.
-TPolynomial straight(const Vector3d& a, const Vector3d& b) {
+TPolynomial straight_polynomial(const Vector3d& a, const Vector3d& b) {
   MatrixXd coefficients(2, 3);
   coefficients.row(0) = a.transpose();
   coefficients.row(1) = (b - a).transpose();
@@ -68,7 +68,7 @@ TEST(SurfacePatchTest, ASplineThroughPointsOfACircularArcFollowsIt) {
 TEST(SurfacePatchTest, ParallelFibresInAPlaneGiveThatRectangle) {
   std::vector<TPolynomial> fibres;
   for (const double x : {0.0, 10.0, 20.0, 30.0})
-    fibres.push_back(straight(Vector3d(x, 0, 0), Vector3d(x, 80, 0)));
+    fibres.push_back(straight_polynomial(Vector3d(x, 0, 0), Vector3d(x, 80, 0)));
   const mesh::IndexedMesh patch = fibre_surface_patch(fibres, 9, 7);
   EXPECT_EQ(patch.V.rows(), 63);
   EXPECT_EQ(patch.F.rows(), 2 * 8 * 6);
@@ -90,7 +90,7 @@ TEST(SurfacePatchTest, FibresOnACylinderGiveAPatchOnTheCylinder) {
   for (int k = 0; k <= 6; ++k) {
     const double angle = std::numbers::pi * k / 6.0;
     const Vector3d around(25 * std::cos(angle), 25 * std::sin(angle), 0);
-    fibres.push_back(straight(around, around + Vector3d(0, 0, 120)));
+    fibres.push_back(straight_polynomial(around, around + Vector3d(0, 0, 120)));
   }
   const mesh::IndexedMesh patch = fibre_surface_patch(fibres, 5, 61);
   // On the cylinder, least away from the edges (measured: 0.061 mm at most,
@@ -111,7 +111,7 @@ TEST(SurfacePatchTest, BadInputIsRefused) {
   EXPECT_THROW((void)cubic_spline(MatrixXd::Zero(1, 3), 5), InvalidInputError);
   EXPECT_THROW((void)cubic_spline(MatrixXd::Zero(3, 3), 5), InvalidInputError);
   EXPECT_THROW((void)cubic_spline(MatrixXd::Random(3, 3), 1), InvalidInputError);
-  const TPolynomial fibre = straight(Vector3d::Zero(), Vector3d(0, 0, 10));
+  const TPolynomial fibre = straight_polynomial(Vector3d::Zero(), Vector3d(0, 0, 10));
   EXPECT_THROW((void)fibre_surface_patch({fibre}, 5, 5), InvalidInputError);
   EXPECT_THROW((void)fibre_surface_patch({fibre, fibre}, 1, 5), InvalidInputError);
   EXPECT_THROW((void)fibre_surface_patch({fibre, TPolynomial(MatrixXd::Ones(2, 2))}, 5, 5),

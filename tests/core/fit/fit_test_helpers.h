@@ -2,7 +2,7 @@
 // Test-only random samples for the fitting tests, drawn from the raw mt19937
 // stream (the standard distributions are implementation-defined; these are
 // portable): uniform numbers, Gaussian noise, directions on the sphere and on
-// a spherical cap, random rotations.
+// a spherical cap, random rotations; and point sets moved by a transform.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -47,6 +47,11 @@ inline double radians(double degrees) { return degrees * std::numbers::pi / 180.
 // Angle of the rotation taking a to b (radians, in [0, pi]).
 inline double rotation_angle_between(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return Eigen::AngleAxisd(a.transpose() * b).angle();
+}
+
+// Each row of `points` mapped by t.
+inline Eigen::MatrixX3d transformed(const Eigen::MatrixX3d& points, const Eigen::Affine3d& t) {
+  return (points * t.linear().transpose()).rowwise() + t.translation().transpose();
 }
 
 }  // namespace mmm::test

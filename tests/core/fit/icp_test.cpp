@@ -17,6 +17,7 @@ namespace {
 using test::degrees;
 using test::radians;
 using test::rotation_angle_between;
+using test::transformed;
 
 // The brief's acceptance bounds for a registration: well below a CT voxel
 // (~0.5 mm) and below what a landmark operator can click (~1 mm, ~1 degree).
@@ -74,10 +75,6 @@ Eigen::MatrixX3d surface_samples(const mesh::IndexedMesh& m, int count, unsigned
     if (normals != nullptr) normals->row(i) = (b - a).cross(c - a).normalized();
   }
   return points;
-}
-
-Eigen::MatrixX3d transformed(const Eigen::MatrixX3d& points, const Eigen::Affine3d& t) {
-  return (points * t.linear().transpose()).rowwise() + t.translation().transpose();
 }
 
 // A motion of `angle_degrees` about an oblique axis through the shape's centre

@@ -28,7 +28,7 @@ Eigen::Isometry3d pose() {
   return t;
 }
 
-mesh::IndexedMesh transformed(mesh::IndexedMesh m, const Eigen::Isometry3d& t) {
+mesh::IndexedMesh transformed_mesh(mesh::IndexedMesh m, const Eigen::Isometry3d& t) {
   for (Eigen::Index v = 0; v < m.V.rows(); ++v) {
     m.V.row(v) = (t * Eigen::Vector3d(m.V.row(v).transpose())).transpose();
   }
@@ -57,7 +57,7 @@ void expect_rotation(const Eigen::Matrix3d& axes) {
 
 TEST(PrincipalAxesTest, SolidBoxHasKnownAxesAndExtents) {
   const Eigen::Isometry3d t = pose();
-  const mesh::IndexedMesh box = transformed(mesh::make_box(-kSize / 2, kSize / 2), t);
+  const mesh::IndexedMesh box = transformed_mesh(mesh::make_box(-kSize / 2, kSize / 2), t);
   const PrincipalAxes p = principal_axes(box);
   EXPECT_TRUE(p.centroid.isApprox(t.translation(), kExact));
   // A solid slab of side a: variance a^2 / 12 along it.
@@ -73,7 +73,7 @@ TEST(PrincipalAxesTest, SolidBoxHasKnownAxesAndExtents) {
 
 TEST(PrincipalAxesTest, BoxCornersHaveHalfSidesAsExtents) {
   const Eigen::Isometry3d t = pose();
-  const mesh::IndexedMesh box = transformed(mesh::make_box(-kSize / 2, kSize / 2), t);
+  const mesh::IndexedMesh box = transformed_mesh(mesh::make_box(-kSize / 2, kSize / 2), t);
   const PrincipalAxes p = principal_axes(box.V);
   EXPECT_TRUE(p.centroid.isApprox(t.translation(), kExact));
   // Every corner sits at +-a/2 along each axis: standard deviation a/2.
@@ -155,7 +155,7 @@ TEST(PrincipalAxesTest, SolidThirdMomentMatchesClosedForm) {
 TEST(PrincipalAxesTest, SkewedAxisFollowsTheShapeNotThePose) {
   const TwoBoxes shape = two_boxes();
   const Eigen::Isometry3d t = pose();
-  const PrincipalAxes solid = principal_axes(transformed(shape.mesh, t));
+  const PrincipalAxes solid = principal_axes(transformed_mesh(shape.mesh, t));
   // Rounding only (see kExact).
   EXPECT_TRUE(solid.axes.col(0).isApprox(t.linear().col(0), kExact));
   EXPECT_TRUE(solid.centroid.isApprox(t * Eigen::Vector3d(shape.mean_x, 5, 5), kExact));
@@ -163,7 +163,7 @@ TEST(PrincipalAxesTest, SkewedAxisFollowsTheShapeNotThePose) {
   // Same for a point set: the cube's corners and the block's corners, the
   // block's weighted down so that it stays the thin tail (equal weights would
   // balance the two ends exactly).
-  const mesh::IndexedMesh moved = transformed(shape.mesh, t);
+  const mesh::IndexedMesh moved = transformed_mesh(shape.mesh, t);
   Eigen::VectorXd weights = Eigen::VectorXd::Ones(moved.V.rows());
   weights.tail(8).setConstant(0.5);
   const PrincipalAxes points = principal_axes(moved.V, weights);

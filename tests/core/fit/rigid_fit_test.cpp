@@ -15,11 +15,12 @@ namespace {
 
 using test::gaussian_vector;
 using test::rotation_angle_between;
+using test::transformed;
 
 // Closed forms on a few dozen points of coordinates ~1e3 mm: rounding leaves
 // ~1e-13 mm; 1e-9 (mm, radians, or relative for scales) is "exact" with a
 // wide margin.
-constexpr double kExact = 1e-9;
+constexpr double kClosedFormExact = 1e-9;
 
 // #P points scattered over a bone-sized, bone-shaped region (a 60 x 40 x 400 mm
 // box, long along z, around a femur's position in the VHF frame), so the
@@ -35,10 +36,6 @@ Eigen::MatrixX3d bone_points(int count, unsigned seed) {
     points.row(i) = p.transpose();
   }
   return points;
-}
-
-Eigen::MatrixX3d transformed(const Eigen::MatrixX3d& points, const Eigen::Affine3d& t) {
-  return (points * t.linear().transpose()).rowwise() + t.translation().transpose();
 }
 
 Eigen::Isometry3d known_motion() {
@@ -61,12 +58,12 @@ TEST(RigidFitTest, KnownRigidTransformIsRecovered) {
   const Eigen::Isometry3d truth = known_motion();
   const Eigen::MatrixX3d target = transformed(source, Eigen::Affine3d(truth.matrix()));
   const RigidFitResult fit = rigid_fit(source, target);
-  EXPECT_LT(rotation_angle_between(fit.rigid.linear(), truth.linear()), kExact);
-  EXPECT_LT((fit.rigid.translation() - truth.translation()).norm(), kExact);
+  EXPECT_LT(rotation_angle_between(fit.rigid.linear(), truth.linear()), kClosedFormExact);
+  EXPECT_LT((fit.rigid.translation() - truth.translation()).norm(), kClosedFormExact);
   EXPECT_DOUBLE_EQ(fit.scale, 1.0);
   EXPECT_TRUE(fit.stretch.isIdentity());
-  EXPECT_LT(fit.rms, kExact);
-  EXPECT_TRUE(fit.transform.matrix().isApprox(truth.matrix(), kExact));
+  EXPECT_LT(fit.rms, kClosedFormExact);
+  EXPECT_TRUE(fit.transform.matrix().isApprox(truth.matrix(), kClosedFormExact));
 }
 
 TEST(RigidFitTest, KnownSimilarityIsRecovered) {
@@ -77,14 +74,14 @@ TEST(RigidFitTest, KnownSimilarityIsRecovered) {
   RigidFitOptions options;
   options.model = TransformModel::kSimilarity;
   const RigidFitResult fit = rigid_fit(source, target, options);
-  EXPECT_NEAR(fit.scale, scale, kExact);
-  EXPECT_TRUE(fit.axis_scales.isApproxToConstant(scale, kExact));
-  EXPECT_LT(rotation_angle_between(fit.rigid.linear(), truth.linear() / scale), kExact);
-  EXPECT_LT(max_mapping_error(source, fit.transform, truth), kExact);
-  EXPECT_LT(fit.rms, kExact);
+  EXPECT_NEAR(fit.scale, scale, kClosedFormExact);
+  EXPECT_TRUE(fit.axis_scales.isApproxToConstant(scale, kClosedFormExact));
+  EXPECT_LT(rotation_angle_between(fit.rigid.linear(), truth.linear() / scale), kClosedFormExact);
+  EXPECT_LT(max_mapping_error(source, fit.transform, truth), kClosedFormExact);
+  EXPECT_LT(fit.rms, kClosedFormExact);
   // transform = rigid * stretch.
-  EXPECT_TRUE(
-      fit.transform.matrix().isApprox((fit.rigid * Eigen::Affine3d(fit.stretch)).matrix(), kExact));
+  EXPECT_TRUE(fit.transform.matrix().isApprox((fit.rigid * Eigen::Affine3d(fit.stretch)).matrix(),
+                                              kClosedFormExact));
 }
 
 TEST(RigidFitTest, RigidModelIgnoresScaleDifference) {
@@ -93,7 +90,7 @@ TEST(RigidFitTest, RigidModelIgnoresScaleDifference) {
   const Eigen::MatrixX3d source = bone_points(40, 3);
   const Eigen::Affine3d truth = Eigen::Affine3d(known_motion().matrix()) * Eigen::Scaling(1.2);
   const RigidFitResult fit = rigid_fit(source, transformed(source, truth));
-  EXPECT_LT(rotation_angle_between(fit.rigid.linear(), known_motion().linear()), kExact);
+  EXPECT_LT(rotation_angle_between(fit.rigid.linear(), known_motion().linear()), kClosedFormExact);
   EXPECT_GT(fit.rms, 1.0);  // 20% of a ~100 mm RMS spread is far above 1 mm
 }
 
@@ -110,9 +107,10 @@ TEST(RigidFitTest, ZeroWeightIgnoresOutlier) {
 
   weights[7] = 0.0;
   const RigidFitResult fit = rigid_fit(source, target, weights);
-  EXPECT_LT(max_mapping_error(source, fit.transform, Eigen::Affine3d(truth.matrix())), kExact);
+  EXPECT_LT(max_mapping_error(source, fit.transform, Eigen::Affine3d(truth.matrix())),
+            kClosedFormExact);
   // The residual counts only weighted pairs.
-  EXPECT_LT(fit.rms, kExact);
+  EXPECT_LT(fit.rms, kClosedFormExact);
 }
 
 TEST(RigidFitTest, WeightedRmsIsTheWeightedResidual) {
@@ -128,7 +126,7 @@ TEST(RigidFitTest, WeightedRmsIsTheWeightedResidual) {
   const Eigen::VectorXd squared =
       (transformed(source, fit.transform) - target).rowwise().squaredNorm();
   // Same sum evaluated two ways: rounding only.
-  EXPECT_NEAR(fit.rms, std::sqrt(weights.dot(squared) / weights.sum()), kExact);
+  EXPECT_NEAR(fit.rms, std::sqrt(weights.dot(squared) / weights.sum()), kClosedFormExact);
   // With noise of 0.5 mm per coordinate, the residual is ~0.5 sqrt(3 - 6/60)
   // mm: within 20% for 60 points (relative sd of the RMS is ~5%).
   EXPECT_NEAR(fit.rms, 0.5 * std::sqrt(3.0 - 6.0 / 60.0), 0.2 * 0.85);
@@ -154,8 +152,8 @@ TEST(RigidFitTest, ReflectedTargetGivesProperRotation) {
     const RigidFitResult fit = rigid_fit(source, target, options);
     const Eigen::Matrix3d r = fit.rigid.linear();
     // Orthonormal with determinant +1 up to rounding.
-    EXPECT_TRUE((r.transpose() * r).isIdentity(kExact));
-    EXPECT_NEAR(r.determinant(), 1.0, kExact);
+    EXPECT_TRUE((r.transpose() * r).isIdentity(kClosedFormExact));
+    EXPECT_NEAR(r.determinant(), 1.0, kClosedFormExact);
     EXPECT_GT(fit.scale, 0.0);
     EXPECT_GT(fit.rms, 1.0);  // a reflection cannot be undone by a motion
   }
@@ -167,7 +165,7 @@ TEST(RigidFitTest, ThreePointsSufficeAndPlanarSetsAreFine) {
   const Eigen::Isometry3d truth = known_motion();
   const RigidFitResult fit =
       rigid_fit(source, transformed(source, Eigen::Affine3d(truth.matrix())));
-  EXPECT_TRUE(fit.transform.matrix().isApprox(truth.matrix(), kExact));
+  EXPECT_TRUE(fit.transform.matrix().isApprox(truth.matrix(), kClosedFormExact));
 }
 
 TEST(RigidFitTest, FewerThanThreeNonCollinearPointsAreRejected) {
@@ -228,12 +226,13 @@ TEST(RigidFitTest, AxisScaledRecoversPerAxisScalesAlongGivenAxes) {
   const RigidFitResult fit = rigid_fit(source, target, options);
   EXPECT_TRUE(fit.converged);
   // Levenberg-Marquardt to convergence on exact data: rounding only.
-  EXPECT_TRUE(fit.axis_scales.isApprox(scales, kExact));
-  EXPECT_TRUE(fit.stretch.isApprox(stretch, kExact));
-  EXPECT_LT(rotation_angle_between(fit.rigid.linear(), known_motion().linear()), kExact);
-  EXPECT_LT(max_mapping_error(source, fit.transform, truth), 1e-7);  // kExact x ~100 mm lever
+  EXPECT_TRUE(fit.axis_scales.isApprox(scales, kClosedFormExact));
+  EXPECT_TRUE(fit.stretch.isApprox(stretch, kClosedFormExact));
+  EXPECT_LT(rotation_angle_between(fit.rigid.linear(), known_motion().linear()), kClosedFormExact);
+  EXPECT_LT(max_mapping_error(source, fit.transform, truth),
+            1e-7);  // kClosedFormExact x ~100 mm lever
   EXPECT_LT(fit.rms, 1e-7);
-  EXPECT_NEAR(fit.scale, std::cbrt(scales.prod()), kExact);
+  EXPECT_NEAR(fit.scale, std::cbrt(scales.prod()), kClosedFormExact);
   EXPECT_TRUE(fit.scale_axes.isApprox(axes));
 }
 
@@ -246,8 +245,8 @@ TEST(RigidFitTest, AxisScaledDefaultsToThePrincipalAxesOfTheSource) {
   RigidFitOptions options;
   options.model = TransformModel::kAxisScaled;
   const RigidFitResult fit = rigid_fit(source, transformed(source, truth), options);
-  EXPECT_TRUE(fit.scale_axes.isApprox(axes, kExact));
-  EXPECT_TRUE(fit.axis_scales.isApprox(scales, kExact));  // rounding only, as above
+  EXPECT_TRUE(fit.scale_axes.isApprox(axes, kClosedFormExact));
+  EXPECT_TRUE(fit.axis_scales.isApprox(scales, kClosedFormExact));  // rounding only, as above
   EXPECT_LT(max_mapping_error(source, fit.transform, truth), 1e-7);
 
   // The similarity fit of the same data cannot follow the proportions.

@@ -16,7 +16,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-constexpr double kRadius = 50.0;
+constexpr double kSphereRadius = 50.0;
 constexpr int kSubdivisions = 4;  // 5120 faces, edges ~4 mm at R = 50
 
 // A small calibrated pair: 150 x 150 mm field, 1 mm detector pitch (0.76 mm
@@ -49,8 +49,8 @@ mesh::IndexedMesh combined(const mesh::IndexedMesh& first, const mesh::IndexedMe
 // whose distance from the centre is between R - gap and R (gap: the deepest
 // face plane, test::icosphere_gap), so the chord is in [2 (R - gap), 2 R].
 TEST(DrrTest, ChordThroughTheSphereCentreIsTwiceTheRadius) {
-  const mesh::IndexedMesh sphere = mesh::make_icosphere(kSubdivisions, kRadius);
-  const double gap = test::icosphere_gap(sphere, kRadius, Eigen::Vector3d::Zero());
+  const mesh::IndexedMesh sphere = mesh::make_icosphere(kSubdivisions, kSphereRadius);
+  const double gap = test::icosphere_gap(sphere, kSphereRadius, Eigen::Vector3d::Zero());
   ASSERT_LT(gap, 0.1);  // ~e^2 / (6 R) for 4 mm edges: 0.05 mm
   const mesh::AabbTree tree(sphere);
   const std::vector<AttenuatingMesh> meshes = {{&tree, 1.0}};
@@ -58,29 +58,29 @@ TEST(DrrTest, ChordThroughTheSphereCentreIsTwiceTheRadius) {
   for (const RadiographView& view : views) {
     const Ray centre = backproject(view, {0.5 * view.width, 0.5 * view.height});
     const double chord = line_integral(centre, meshes);
-    EXPECT_LE(chord, 2 * kRadius + 1e-9);  // 1e-9: rounding of t ~ 1300 mm
-    EXPECT_GE(chord, 2 * (kRadius - gap) - 1e-9);
+    EXPECT_LE(chord, 2 * kSphereRadius + 1e-9);  // 1e-9: rounding of t ~ 1300 mm
+    EXPECT_GE(chord, 2 * (kSphereRadius - gap) - 1e-9);
   }
   // Off-centre: the ray toward (-0.6 R, 0, 0) passes the centre at distance
   // h (slightly less than 0.6 R: the ray is tilted). The chord 2 sqrt(R^2 -
   // h^2) changes with the radius by 2 R / sqrt(R^2 - h^2) = 2.5, so the
   // tessellation shortens it by at most 2.5 gap per end.
   const RadiographView& frontal = views[0];
-  const Eigen::Vector3d target(-0.6 * kRadius, 0, 0);
+  const Eigen::Vector3d target(-0.6 * kSphereRadius, 0, 0);
   const Ray ray{frontal.source_mm, (target - frontal.source_mm).normalized()};
   const double h = frontal.source_mm.cross(ray.direction).norm();
-  const double expected = 2 * std::sqrt(kRadius * kRadius - h * h);
+  const double expected = 2 * std::sqrt(kSphereRadius * kSphereRadius - h * h);
   EXPECT_LE(line_integral(ray, meshes), expected + 1e-9);
   EXPECT_GE(line_integral(ray, meshes), expected - 5 * gap);
   // A ray passing beside the sphere sees nothing, exactly.
-  const Eigen::Vector3d above(0, 0, 1.2 * kRadius);  // the ray passes ~1.2 R away
+  const Eigen::Vector3d above(0, 0, 1.2 * kSphereRadius);  // the ray passes ~1.2 R away
   const Ray beside{frontal.source_mm, (above - frontal.source_mm).normalized()};
   EXPECT_EQ(line_integral(beside, meshes), 0.0);
 }
 
 TEST(DrrTest, ImageOfASphereShowsItsShadowAndNothingElse) {
-  const mesh::IndexedMesh sphere = mesh::make_icosphere(kSubdivisions, kRadius);
-  const double gap = test::icosphere_gap(sphere, kRadius, Eigen::Vector3d::Zero());
+  const mesh::IndexedMesh sphere = mesh::make_icosphere(kSubdivisions, kSphereRadius);
+  const double gap = test::icosphere_gap(sphere, kSphereRadius, Eigen::Vector3d::Zero());
   const mesh::AabbTree tree(sphere);
   const std::vector<AttenuatingMesh> meshes = {{&tree, 1.0}};
   const RadiographView view = small_views()[0];
@@ -92,11 +92,11 @@ TEST(DrrTest, ImageOfASphereShowsItsShadowAndNothingElse) {
   // tessellation (2 gap) and the offset (0.54^2 / R = 0.006 mm); floats keep
   // 1e-5 mm at 100 mm.
   const float peak = *std::max_element(drr.pixels.begin(), drr.pixels.end());
-  EXPECT_NEAR(peak, 2 * kRadius, 2 * gap + 0.01);
+  EXPECT_NEAR(peak, 2 * kSphereRadius, 2 * gap + 0.01);
   // The shadow is the disc of rays within R of the centre: a cone of half
   // angle asin(R / D) cutting the isocentre plane in radius D tan(asin(R/D)).
   const double D = (view.source_mm).norm();
-  const double shadow_px = D * std::tan(std::asin(kRadius / D)) / view.pixel_spacing_mm;
+  const double shadow_px = D * std::tan(std::asin(kSphereRadius / D)) / view.pixel_spacing_mm;
   int covered = 0;
   for (int y = 0; y < drr.height; ++y) {
     for (int x = 0; x < drr.width; ++x) {
@@ -117,9 +117,9 @@ TEST(DrrTest, ImageOfASphereShowsItsShadowAndNothingElse) {
 
 TEST(DrrTest, NestedMeshesAdd) {
   const double inner_radius = 25.0;
-  const mesh::IndexedMesh outer = mesh::make_icosphere(kSubdivisions, kRadius);
+  const mesh::IndexedMesh outer = mesh::make_icosphere(kSubdivisions, kSphereRadius);
   const mesh::IndexedMesh inner = mesh::make_icosphere(kSubdivisions, inner_radius);
-  const double gap_outer = test::icosphere_gap(outer, kRadius, Eigen::Vector3d::Zero());
+  const double gap_outer = test::icosphere_gap(outer, kSphereRadius, Eigen::Vector3d::Zero());
   const double gap_inner = test::icosphere_gap(inner, inner_radius, Eigen::Vector3d::Zero());
   const mesh::AabbTree outer_tree(outer);
   const mesh::AabbTree inner_tree(inner);
@@ -127,7 +127,7 @@ TEST(DrrTest, NestedMeshesAdd) {
                                                {&inner_tree, kBoneMuPerMm}};
   const RadiographView view = small_views()[1];
   const Ray centre = backproject(view, {0.5 * view.width, 0.5 * view.height});
-  const double expected = kSoftTissueMuPerMm * 2 * kRadius + kBoneMuPerMm * 2 * inner_radius;
+  const double expected = kSoftTissueMuPerMm * 2 * kSphereRadius + kBoneMuPerMm * 2 * inner_radius;
   // Each chord is short by at most twice its sphere's gap (see above).
   const double tolerance = 2 * (kSoftTissueMuPerMm * gap_outer + kBoneMuPerMm * gap_inner) + 1e-9;
   EXPECT_NEAR(line_integral(centre, meshes), expected, tolerance);
@@ -142,9 +142,9 @@ TEST(DrrTest, NestedMeshesAdd) {
 // inside for 2 (R - r), not 2 R.
 TEST(DrrTest, InwardFacingShellIsACavity) {
   const double inner_radius = 20.0;
-  const mesh::IndexedMesh outer = mesh::make_icosphere(kSubdivisions, kRadius);
+  const mesh::IndexedMesh outer = mesh::make_icosphere(kSubdivisions, kSphereRadius);
   const mesh::IndexedMesh inner = mesh::make_icosphere(kSubdivisions, inner_radius);
-  const double gap_outer = test::icosphere_gap(outer, kRadius, Eigen::Vector3d::Zero());
+  const double gap_outer = test::icosphere_gap(outer, kSphereRadius, Eigen::Vector3d::Zero());
   const double gap_inner = test::icosphere_gap(inner, inner_radius, Eigen::Vector3d::Zero());
   const mesh::AabbTree hollow(combined(outer, reversed(inner)));
   const std::vector<AttenuatingMesh> meshes = {{&hollow, 1.0}};
@@ -152,7 +152,7 @@ TEST(DrrTest, InwardFacingShellIsACavity) {
   const Ray centre = backproject(view, {0.5 * view.width, 0.5 * view.height});
   // The outer chord is short by up to 2 gap_outer, the cavity's by up to
   // 2 gap_inner (which lengthens the wall).
-  EXPECT_NEAR(line_integral(centre, meshes), 2 * (kRadius - inner_radius),
+  EXPECT_NEAR(line_integral(centre, meshes), 2 * (kSphereRadius - inner_radius),
               2 * (gap_outer + gap_inner));
   // render_drr accepts it: the enclosed volume is positive.
   EXPECT_NO_THROW((void)render_drr(view, meshes));
@@ -161,16 +161,16 @@ TEST(DrrTest, InwardFacingShellIsACavity) {
 // Two overlapping spheres in one mesh count once where they overlap (the
 // depth count is a winding number), not twice.
 TEST(DrrTest, OverlappingComponentsOfOneMeshCountOnce) {
-  const mesh::IndexedMesh a = mesh::make_icosphere(kSubdivisions, kRadius, {0, 0, 0});
-  const mesh::IndexedMesh b = mesh::make_icosphere(kSubdivisions, kRadius, {0, -30, 0});
+  const mesh::IndexedMesh a = mesh::make_icosphere(kSubdivisions, kSphereRadius, {0, 0, 0});
+  const mesh::IndexedMesh b = mesh::make_icosphere(kSubdivisions, kSphereRadius, {0, -30, 0});
   const mesh::AabbTree both(combined(a, b));
   const std::vector<AttenuatingMesh> meshes = {{&both, 1.0}};
   // The frontal central ray runs along -y through both centres: the union
   // spans y in [-30 - R, R], 2 R + 30 mm.
   const RadiographView view = small_views()[0];
   const Ray centre = backproject(view, {0.5 * view.width, 0.5 * view.height});
-  const double gap = test::icosphere_gap(a, kRadius, Eigen::Vector3d::Zero());
-  EXPECT_NEAR(line_integral(centre, meshes), 2 * kRadius + 30, 2 * gap);
+  const double gap = test::icosphere_gap(a, kSphereRadius, Eigen::Vector3d::Zero());
+  EXPECT_NEAR(line_integral(centre, meshes), 2 * kSphereRadius + 30, 2 * gap);
 }
 
 TEST(DrrTest, ThreadCountDoesNotChangeTheImage) {

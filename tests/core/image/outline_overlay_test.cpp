@@ -30,9 +30,9 @@ namespace {
 using ::testing::AllOf;
 using ::testing::HasSubstr;
 
-constexpr Rgb8 kRed{230, 40, 40};
-constexpr Rgb8 kBlue{40, 90, 240};
-constexpr Rgb8 kYellow{250, 230, 20};
+constexpr Rgb8 kOutlineRed{230, 40, 40};
+constexpr Rgb8 kOutlineBlue{40, 90, 240};
+constexpr Rgb8 kOutlineYellow{250, 230, 20};
 
 // A line of width 1.5 px (the default) reaches pixel centres up to
 // 1.5 / 2 + 0.5 = 1.25 px from it (the anti-aliasing ramp).
@@ -40,7 +40,7 @@ constexpr double kReach = 1.25;
 
 // Two views of a 200 x 200 mm field around the origin (872 x 872 pixels of
 // 0.229 mm at the isocentre): small enough for quick tests.
-std::array<RadiographView, 2> small_views() {
+std::array<RadiographView, 2> small_overlay_views() {
   BiplanarOptions options;
   options.field_width_mm = 200;
   options.field_height_mm = 200;
@@ -116,8 +116,8 @@ TEST(OutlineOverlayTest, SphereAtTheIsocentreIsOutlinedByItsProjectedTangentCirc
   // tangent circle, so they project at most 220 px * 0.019^2 / 2 = 0.04 px
   // inside it; chords sag by less still.
   const mesh::IndexedMesh sphere = mesh::make_icosphere(5, kRadius);
-  const std::vector<OutlineItem> items = {{"sphere", &sphere, kRed}};
-  for (const RadiographView& view : small_views()) {
+  const std::vector<OutlineItem> items = {{"sphere", &sphere, kOutlineRed}};
+  for (const RadiographView& view : small_overlay_views()) {
     SCOPED_TRACE(view.name);
     const GrayImage16 radiograph = ramp(view);
     const RgbImage8 image = outline_overlay(view, radiograph, items, plain_options());
@@ -166,8 +166,8 @@ TEST(OutlineOverlayTest, BoxSeenFrontallyIsOutlinedByItsNearFaceRectangle) {
   // 1300/1330): the silhouette is the near face's rectangle, its edges
   // shared by the front-facing near face and the back-facing sides.
   const mesh::IndexedMesh box = mesh::make_box({-40, -30, -60}, {40, 30, 60});
-  const std::vector<OutlineItem> items = {{"box", &box, kBlue}};
-  const RadiographView view = small_views()[0];
+  const std::vector<OutlineItem> items = {{"box", &box, kOutlineBlue}};
+  const RadiographView view = small_overlay_views()[0];
   const GrayImage16 radiograph = ramp(view);
   const RgbImage8 image = outline_overlay(view, radiograph, items, plain_options());
   const Eigen::Vector2d a = project(view, {-40, 30, -60});
@@ -207,8 +207,8 @@ TEST(OutlineOverlayTest, OpenSurfaceIsOutlinedAlongItsBoundaryOnly) {
   grid.V.col(0) = planar.col(0).array() - 50;  // x in [-50, 50]
   grid.V.col(1).setZero();                     // y = 0
   grid.V.col(2) = planar.col(1).array() - 50;  // z in [-50, 50]
-  const std::vector<OutlineItem> items = {{"grid", &grid, kYellow}};
-  const RadiographView view = small_views()[0];
+  const std::vector<OutlineItem> items = {{"grid", &grid, kOutlineYellow}};
+  const RadiographView view = small_overlay_views()[0];
   const GrayImage16 radiograph = ramp(view);
   const RgbImage8 image = outline_overlay(view, radiograph, items, plain_options());
   const Eigen::Vector2d a = project(view, {-50, 0, -50});
@@ -236,11 +236,11 @@ TEST(OutlineOverlayTest, SmallSilhouetteLoopsAreDroppedUnlessAsked) {
     if (y(f) > y(nearest)) nearest = f;
   }
   std::swap(flipped.F(nearest, 1), flipped.F(nearest, 2));
-  const RadiographView view = small_views()[0];
+  const RadiographView view = small_overlay_views()[0];
   const GrayImage16 radiograph = ramp(view);
   OverlayOptions options = plain_options();
-  const std::vector<OutlineItem> clean = {{"sphere", &sphere, kRed}};
-  const std::vector<OutlineItem> noisy = {{"sphere", &flipped, kRed}};
+  const std::vector<OutlineItem> clean = {{"sphere", &sphere, kOutlineRed}};
+  const std::vector<OutlineItem> noisy = {{"sphere", &flipped, kOutlineRed}};
   // Dropped by default (fewer than 8 edges): the picture is the clean one.
   EXPECT_EQ(outline_overlay(view, radiograph, noisy, options).pixels,
             outline_overlay(view, radiograph, clean, options).pixels);
@@ -263,7 +263,7 @@ TEST(OutlineOverlayTest, SmallSilhouetteLoopsAreDroppedUnlessAsked) {
   triangle.V << -30, 0, -30, 30, 0, -30, 0, 0, 30;
   triangle.F.resize(1, 3);
   triangle.F << 0, 1, 2;
-  const std::vector<OutlineItem> lone = {{"triangle", &triangle, kRed}};
+  const std::vector<OutlineItem> lone = {{"triangle", &triangle, kOutlineRed}};
   EXPECT_GT(
       drawn_pixels(outline_overlay(view, radiograph, lone, plain_options()), radiograph).size(),
       500U);  // three sides of 260 px or more
@@ -272,14 +272,15 @@ TEST(OutlineOverlayTest, SmallSilhouetteLoopsAreDroppedUnlessAsked) {
 TEST(OutlineOverlayTest, ItemsAndMarkersAreDrawnInTheirColours) {
   const mesh::IndexedMesh sphere = mesh::make_icosphere(4, 30.0, {-50, 0, 0});
   const mesh::IndexedMesh box = mesh::make_box({30, -20, -20}, {80, 20, 20});
-  const std::vector<OutlineItem> items = {{"sphere", &sphere, kRed}, {"box", &box, kBlue}};
-  const RadiographView view = small_views()[0];
+  const std::vector<OutlineItem> items = {{"sphere", &sphere, kOutlineRed},
+                                          {"box", &box, kOutlineBlue}};
+  const RadiographView view = small_overlay_views()[0];
   const GrayImage16 flat(view.width, view.height, 1000);  // every pixel black
   OverlayOptions options;
   options.legend = false;
   options.line_width_px = 3.0;  // full coverage within 1 px of a line
-  options.points = {{{0, 0, 60}, kYellow, PointMarker::kCross},
-                    {{0, 0, -60}, kYellow, PointMarker::kCircle}};
+  options.points = {{{0, 0, 60}, kOutlineYellow, PointMarker::kCross},
+                    {{0, 0, -60}, kOutlineYellow, PointMarker::kCircle}};
   const RgbImage8 image = outline_overlay(view, flat, items, options);
   std::map<std::array<int, 3>, int> histogram;
   for (int y = 0; y < image.height; ++y) {
@@ -293,16 +294,16 @@ TEST(OutlineOverlayTest, ItemsAndMarkersAreDrawnInTheirColours) {
   EXPECT_GT((histogram[{0, 0, 0}]), image.width * image.height / 2);
   // Hundreds of pixels exactly in each colour (lines of 3 px along
   // perimeters of several hundred px).
-  EXPECT_GT((histogram[{kRed.r, kRed.g, kRed.b}]), 500);
-  EXPECT_GT((histogram[{kBlue.r, kBlue.g, kBlue.b}]), 500);
-  EXPECT_GT((histogram[{kYellow.r, kYellow.g, kYellow.b}]), 40);
+  EXPECT_GT((histogram[{kOutlineRed.r, kOutlineRed.g, kOutlineRed.b}]), 500);
+  EXPECT_GT((histogram[{kOutlineBlue.r, kOutlineBlue.g, kOutlineBlue.b}]), 500);
+  EXPECT_GT((histogram[{kOutlineYellow.r, kOutlineYellow.g, kOutlineYellow.b}]), 40);
   // Every other pixel is a blend of black with one of the colours: its
   // channels are the colour's scaled by one coverage, taken from the
   // colour's strongest channel (+-1.5 for the rounding of both).
   for (const auto& [c, count] : histogram) {
     if (c == std::array<int, 3>{0, 0, 0}) continue;
     bool blend = false;
-    for (const Rgb8 colour : {kRed, kBlue, kYellow}) {
+    for (const Rgb8 colour : {kOutlineRed, kOutlineBlue, kOutlineYellow}) {
       const std::array<double, 3> target = {static_cast<double>(colour.r),
                                             static_cast<double>(colour.g),
                                             static_cast<double>(colour.b)};
@@ -323,27 +324,27 @@ TEST(OutlineOverlayTest, ItemsAndMarkersAreDrawnInTheirColours) {
     return get_rgb(image, static_cast<int>(std::floor(p.x())), static_cast<int>(std::floor(p.y())));
   };
   const double r = options.marker_radius_px;
-  EXPECT_EQ(colour_at(cross), kYellow);
-  EXPECT_EQ(colour_at(cross + Eigen::Vector2d(r - 1, 0)), kYellow);
-  EXPECT_EQ(colour_at(cross + Eigen::Vector2d(0, 1 - r)), kYellow);
+  EXPECT_EQ(colour_at(cross), kOutlineYellow);
+  EXPECT_EQ(colour_at(cross + Eigen::Vector2d(r - 1, 0)), kOutlineYellow);
+  EXPECT_EQ(colour_at(cross + Eigen::Vector2d(0, 1 - r)), kOutlineYellow);
   EXPECT_EQ(colour_at(cross + Eigen::Vector2d(r / 2, r / 2)), (Rgb8{0, 0, 0}));
-  EXPECT_EQ(colour_at(ring + Eigen::Vector2d(r, 0)), kYellow);
-  EXPECT_EQ(colour_at(ring + Eigen::Vector2d(0, -r)), kYellow);
+  EXPECT_EQ(colour_at(ring + Eigen::Vector2d(r, 0)), kOutlineYellow);
+  EXPECT_EQ(colour_at(ring + Eigen::Vector2d(0, -r)), kOutlineYellow);
   EXPECT_EQ(colour_at(ring), (Rgb8{0, 0, 0}));
 }
 
 TEST(OutlineOverlayTest, LegendIsAColumnOfSwatchesInTheItemsOrder) {
   const mesh::IndexedMesh sphere = mesh::make_icosphere(2, 10.0);
   const std::vector<OutlineItem> items = {
-      {"a", &sphere, kRed}, {"b", &sphere, kBlue}, {"c", &sphere, kYellow}};
-  const RadiographView view = small_views()[0];
+      {"a", &sphere, kOutlineRed}, {"b", &sphere, kOutlineBlue}, {"c", &sphere, kOutlineYellow}};
+  const RadiographView view = small_overlay_views()[0];
   OverlayOptions options = plain_options();
   options.legend = true;
   const RgbImage8 image = outline_overlay(view, ramp(view), items, options);
   // Swatches of 14 px every 18 px from (8, 8), with a black border.
-  EXPECT_EQ(get_rgb(image, 15, 15), kRed);
-  EXPECT_EQ(get_rgb(image, 15, 15 + 18), kBlue);
-  EXPECT_EQ(get_rgb(image, 15, 15 + 36), kYellow);
+  EXPECT_EQ(get_rgb(image, 15, 15), kOutlineRed);
+  EXPECT_EQ(get_rgb(image, 15, 15 + 18), kOutlineBlue);
+  EXPECT_EQ(get_rgb(image, 15, 15 + 36), kOutlineYellow);
   EXPECT_EQ(get_rgb(image, 8, 15), (Rgb8{0, 0, 0}));
   EXPECT_EQ(get_rgb(image, 15, 8 + 36 + 13), (Rgb8{0, 0, 0}));
 }
@@ -382,7 +383,7 @@ TEST(OutlineOverlayTest, DefaultWindowSpansThe1stTo99thPercentile) {
 RadiographPair ramp_pair(const test::ScratchDir& dir) {
   std::vector<RadiographFile> files;
   std::map<std::string, std::string> png;
-  for (const RadiographView& view : small_views()) {
+  for (const RadiographView& view : small_overlay_views()) {
     write_png(ramp(view), dir / (view.name + ".png"));
     png[view.name] = test::read_text(dir / (view.name + ".png"));
     files.push_back({view, view.name + ".png"});
@@ -393,10 +394,10 @@ RadiographPair ramp_pair(const test::ScratchDir& dir) {
 TEST(OutlineOverlayTest, PairIsBothViewsSideBySideScaledDownToMaxWidth) {
   const test::ScratchDir dir("outline_overlay_pair");
   const RadiographPair pair = ramp_pair(dir);
-  const std::array<RadiographView, 2> views = small_views();
+  const std::array<RadiographView, 2> views = small_overlay_views();
   constexpr double kRadius = 50.0;
   const mesh::IndexedMesh sphere = mesh::make_icosphere(5, kRadius);
-  const std::vector<OutlineItem> items = {{"sphere", &sphere, kRed}};
+  const std::vector<OutlineItem> items = {{"sphere", &sphere, kOutlineRed}};
   OverlayOptions options = plain_options();
   const RgbImage8 full = outline_overlay_pair(pair, items, options);
   EXPECT_EQ(full.width, views[0].width + 10 + views[1].width);
@@ -424,7 +425,7 @@ TEST(OutlineOverlayTest, PairIsBothViewsSideBySideScaledDownToMaxWidth) {
   int red = 0;
   for (int y = 0; y < half.height; ++y) {
     for (int x = 0; x < width; ++x) {
-      if (get_rgb(half, x, y) != kRed) continue;
+      if (get_rgb(half, x, y) != kOutlineRed) continue;
       ++red;
       // Tangent-point radius vs the equator point's: < 0.2 px at this
       // size; the resampled grid rounds the height by up to 0.5 px (0.3 px
@@ -436,7 +437,7 @@ TEST(OutlineOverlayTest, PairIsBothViewsSideBySideScaledDownToMaxWidth) {
 }
 
 TEST(OutlineOverlayTest, BadInputIsRejectedWithItsName) {
-  const RadiographView view = small_views()[0];
+  const RadiographView view = small_overlay_views()[0];
   const GrayImage16 radiograph = ramp(view);
   const mesh::IndexedMesh sphere = mesh::make_icosphere(2, 10.0);
   const auto message = [&](const std::vector<OutlineItem>& items, const GrayImage16& image,
@@ -448,17 +449,18 @@ TEST(OutlineOverlayTest, BadInputIsRejectedWithItsName) {
     }
     return "no error";
   };
-  EXPECT_THAT(message({{"sphere", &sphere, kRed}, {"femur_r", nullptr, kRed}}, radiograph),
-              AllOf(HasSubstr("item 1 ('femur_r')"), HasSubstr("null")));
+  EXPECT_THAT(
+      message({{"sphere", &sphere, kOutlineRed}, {"femur_r", nullptr, kOutlineRed}}, radiograph),
+      AllOf(HasSubstr("item 1 ('femur_r')"), HasSubstr("null")));
   mesh::IndexedMesh broken = sphere;
   broken.V(5, 1) = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THAT(message({{"tibia_r", &broken, kRed}}, radiograph),
+  EXPECT_THAT(message({{"tibia_r", &broken, kOutlineRed}}, radiograph),
               AllOf(HasSubstr("'tibia_r'"), HasSubstr("vertex 5"), HasSubstr("non-finite")));
   EXPECT_THAT(message({}, GrayImage16(10, 20)),
               AllOf(HasSubstr("view 'frontal' is 872 x 872"), HasSubstr("radiograph 10 x 20")));
   // Beyond the frontal source (y = +1300 mm): a mesh in the wrong frame or units.
   const mesh::IndexedMesh behind = mesh::make_icosphere(1, 10.0, {0, 2000, 0});
-  EXPECT_THAT(message({{"pelvis", &behind, kRed}}, radiograph),
+  EXPECT_THAT(message({{"pelvis", &behind, kOutlineRed}}, radiograph),
               AllOf(HasSubstr("'pelvis'"), HasSubstr("behind the source")));
   OverlayOptions options;
   options.line_width_px = 0;
@@ -539,18 +541,18 @@ TEST(OutlineOverlayTest, GroundTruthBonesSitOnTheirEdgesInTheFixtureRadiographs)
   std::vector<OutlineItem> items;
   std::vector<OutlineItem> moved_items;
   for (std::size_t k = 0; k < meshes.size(); ++k) {
-    items.push_back({atlas.bones[k].name, &meshes[k], kRed});
-    moved_items.push_back({atlas.bones[k].name, &moved[k], kRed});
+    items.push_back({atlas.bones[k].name, &meshes[k], kOutlineRed});
+    moved_items.push_back({atlas.bones[k].name, &moved[k], kOutlineRed});
   }
   OverlayOptions options;
   options.legend = false;
   for (const RadiographFile& file : pair.views) {
     SCOPED_TRACE(file.view.name);
     const GrayImage16 radiograph = pair.image(file.view.name);
-    const double aligned =
-        edge_contrast(radiograph, outline_overlay(file.view, radiograph, items, options), kRed);
+    const double aligned = edge_contrast(
+        radiograph, outline_overlay(file.view, radiograph, items, options), kOutlineRed);
     const double off = edge_contrast(
-        radiograph, outline_overlay(file.view, radiograph, moved_items, options), kRed);
+        radiograph, outline_overlay(file.view, radiograph, moved_items, options), kOutlineRed);
     // Bone edges in a DRR are steep: on seed 1's outlines the gradient is
     // 11.2 (frontal) and 12.1 (lateral) times the image's mean; 3 mm (8 px)
     // off it drops to 4.6 and 5.5 (wide bones' edges still cross some of the

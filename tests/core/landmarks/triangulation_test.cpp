@@ -16,7 +16,7 @@ namespace {
 using image::RadiographView;
 
 // A standing adult's right leg in a field centred at knee height.
-std::array<RadiographView, 2> leg_views() {
+std::array<RadiographView, 2> knee_centred_views() {
   image::BiplanarOptions options;
   options.isocentre_mm = {0, 0, 500};
   return image::make_biplanar_views(options);
@@ -40,7 +40,7 @@ double cost(std::span<const RadiographView> views, std::span<const Eigen::Vector
 }
 
 TEST(TriangulationTest, ExactPixelsGiveThePoint) {
-  const auto views = leg_views();
+  const auto views = knee_centred_views();
   for (const Eigen::Vector3d& X :
        {Eigen::Vector3d(90, 0, 900), Eigen::Vector3d(80, 30, 480), Eigen::Vector3d(75, 0, 80)}) {
     const std::vector<Eigen::Vector2d> pixels = project_all(views, X);
@@ -57,7 +57,7 @@ TEST(TriangulationTest, ExactPixelsGiveThePoint) {
 }
 
 TEST(TriangulationTest, NoisyPixelsCostNoMoreThanTheLinearPoint) {
-  const auto views = leg_views();
+  const auto views = knee_centred_views();
   std::mt19937 rng(20240611);
   // 3 pixels of click noise (0.7 mm at the isocentre).
   std::normal_distribution<double> noise(0.0, 3.0);
@@ -88,7 +88,7 @@ TEST(TriangulationTest, ThreeViewsOfDifferentResolution) {
   // A third view at 1/4 of the resolution (the frontal geometry with a
   // coarser detector): exact pixels still give the point, and its error is
   // counted in mm (a pixel there is 4 times as many mm).
-  const auto pair = leg_views();
+  const auto pair = knee_centred_views();
   image::BiplanarOptions coarse_options;
   coarse_options.isocentre_mm = {0, 0, 500};
   coarse_options.detector_pixel_pitch_mm = 1.2;
@@ -115,7 +115,7 @@ TEST(TriangulationTest, ThreeViewsOfDifferentResolution) {
 }
 
 TEST(TriangulationTest, DegenerateInputIsRejected) {
-  const auto views = leg_views();
+  const auto views = knee_centred_views();
   const Eigen::Vector3d X(80, 30, 480);
   const std::vector<Eigen::Vector2d> pixels = project_all(views, X);
   // One view.

@@ -55,11 +55,7 @@ double brute_force_squared_distance(const IndexedMesh& mesh, const Eigen::Vector
   return best;
 }
 
-Eigen::Vector3d uniform_in(const Eigen::AlignedBox3d& box, std::mt19937& rng) {
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const Eigen::Vector3d s(unit(rng), unit(rng), unit(rng));
-  return box.min() + s.cwiseProduct(box.sizes());
-}
+using test::uniform_in;
 
 // Compares the tree with brute force at `count` uniform points of `box`.
 void expect_closest_points_match(const IndexedMesh& mesh, const Eigen::AlignedBox3d& box, int count,

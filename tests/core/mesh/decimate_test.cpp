@@ -20,7 +20,6 @@ namespace {
 using test::count_boundary_edges;
 using test::euler_characteristic;
 using test::is_closed_edge_manifold;
-using test::signed_volume;
 
 TEST(DecimateTest, IcosphereToTwoThousandFacesStaysAClosedSphere) {
   const IndexedMesh sphere = make_icosphere(5);
@@ -44,8 +43,8 @@ TEST(DecimateTest, IcosphereToTwoThousandFacesStaysAClosedSphere) {
   // of a percent of the sphere's volume, the 20480-face input ~0.04%; the
   // greedy decimation's uneven triangles make it 0.66% (measured): 1% bounds
   // it.
-  const double volume_before = signed_volume(sphere);
-  EXPECT_NEAR(signed_volume(coarse), volume_before, 0.01 * volume_before);
+  const double volume_before = test::signed_volume(sphere);
+  EXPECT_NEAR(test::signed_volume(coarse), volume_before, 0.01 * volume_before);
   // Half-edge collapses keep surviving vertices where they were, on the unit
   // sphere up to the rounding of the icosphere's normalisation.
   const Eigen::VectorXd radii = coarse.V.rowwise().norm();
@@ -64,8 +63,8 @@ TEST(DecimateTest, TorusKeepsItsGenus) {
   // input's 48 segments around the tube, about 1.4% for the ~22 that 3000
   // uniform faces would leave; the quadric keeps more segments around the
   // tube (measured loss 0.33%). 2% bounds the uniform estimate.
-  const double volume_before = signed_volume(torus);
-  EXPECT_NEAR(signed_volume(coarse), volume_before, 0.02 * volume_before);
+  const double volume_before = test::signed_volume(torus);
+  EXPECT_NEAR(test::signed_volume(coarse), volume_before, 0.02 * volume_before);
 }
 
 TEST(DecimateTest, PreservedBoundaryOfAnOpenMeshStaysInPlace) {
@@ -200,8 +199,8 @@ TEST(DecimateTest, GluteusMaximusToFiveThousandFaces) {
   EXPECT_EQ(euler_characteristic(coarse), 2);
   // The quadric metric keeps the smooth muscle's shape: volume changes by
   // 0.16% (measured) of its ~822 cm^3; 1% is the decimation contract.
-  const double volume_before = signed_volume(muscle);
-  EXPECT_NEAR(signed_volume(coarse), volume_before, 0.01 * volume_before);
+  const double volume_before = test::signed_volume(muscle);
+  EXPECT_NEAR(test::signed_volume(coarse), volume_before, 0.01 * volume_before);
   // Every input vertex stays close to the coarse surface: 0.43 mm measured,
   // against ~5.5 mm edges of the 5000-face result and a muscle about 200 mm
   // long. 1 mm is well below what a dropped feature would cost.

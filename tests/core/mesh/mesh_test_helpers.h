@@ -106,6 +106,13 @@ inline double signed_volume(const mesh::IndexedMesh& mesh) {
   return volume;
 }
 
+// A point uniform in `box`.
+inline Eigen::Vector3d uniform_in(const Eigen::AlignedBox3d& box, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Eigen::Vector3d s(unit(rng), unit(rng), unit(rng));
+  return box.min() + s.cwiseProduct(box.sizes());
+}
+
 inline double triangle_area(const mesh::IndexedMesh& mesh, Eigen::Index f) {
   const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose();
   const Eigen::Vector3d b = mesh.V.row(mesh.F(f, 1)).transpose();

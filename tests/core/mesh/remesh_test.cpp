@@ -21,7 +21,6 @@ using test::edge_face_counts;
 using test::euler_characteristic;
 using test::is_closed_edge_manifold;
 using test::mean_edge_length;
-using test::signed_volume;
 
 // Largest distance from a vertex of `mesh` to the surface of `reference`.
 double farthest_vertex_from(const IndexedMesh& mesh, const IndexedMesh& reference) {
@@ -55,8 +54,8 @@ void expect_uniform_remesh(const IndexedMesh& input, double target, const char* 
   // Vertices sit on the input, so the new polyhedron is inscribed in it: the
   // volume lost to the chords of edges of length L on these smooth shapes is
   // about 0.4% to 1.5% (measured); 2% is the contract.
-  const double volume = signed_volume(input);
-  EXPECT_NEAR(signed_volume(output), volume, 0.02 * volume) << label;
+  const double volume = test::signed_volume(input);
+  EXPECT_NEAR(test::signed_volume(output), volume, 0.02 * volume) << label;
   // Projection is exact up to the rounding of closest-point queries.
   const double size = (input.V.colwise().maxCoeff() - input.V.colwise().minCoeff()).norm();
   EXPECT_LT(farthest_vertex_from(output, input), 1e-12 * size) << label;
@@ -130,8 +129,8 @@ TEST(RemeshTest, GluteusMaximusAtThreeMillimetres) {
   EXPECT_NEAR(mean_edge_length(output), 3.0, 0.2 * 3.0);
   EXPECT_TRUE(is_closed_edge_manifold(output.F));
   EXPECT_EQ(euler_characteristic(output), 2);
-  const double volume = signed_volume(muscle);
-  EXPECT_NEAR(signed_volume(output), volume, 0.02 * volume);
+  const double volume = test::signed_volume(muscle);
+  EXPECT_NEAR(test::signed_volume(output), volume, 0.02 * volume);
   // Every input vertex stays within a third of an edge of the new surface
   // (0.91 mm measured): chords of 3 mm edges over the muscle's curvature.
   EXPECT_LT(farthest_vertex_from(muscle, output), 1.0);

@@ -11,6 +11,7 @@
 #include "core/mesh/aabb_tree.h"
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/primitives.h"
+#include "tests/core/mesh/mesh_test_helpers.h"
 #include "tests/support/test_data.h"
 
 namespace mmm::mesh {
@@ -36,11 +37,7 @@ double longest_edge(const IndexedMesh& mesh) {
   return longest;
 }
 
-Eigen::Vector3d uniform_in(const Eigen::AlignedBox3d& box, std::mt19937& rng) {
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const Eigen::Vector3d s(unit(rng), unit(rng), unit(rng));
-  return box.min() + s.cwiseProduct(box.sizes());
-}
+using test::uniform_in;
 
 // A cube [-1, 1]^3 without its top face (z = 1): an open surface.
 IndexedMesh open_box() {

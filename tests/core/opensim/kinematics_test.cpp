@@ -10,10 +10,6 @@
 namespace mmm::opensim {
 namespace {
 
-std::filesystem::path gait2392() {
-  return test::data_dir() / "gait2392" / "gait2392_thelen2003muscle.osim";
-}
-
 Body body_named(const std::string& name, bool is_ground = false) {
   Body body;
   body.name = name;
@@ -93,7 +89,7 @@ TEST(KinematicsTest, DisconnectedBodyIsAnError) {
 }
 
 TEST(KinematicsTest, Gait2392DefaultPoseStacksTheLegBelowTheHip) {
-  const OsimModel model = read_osim(gait2392());
+  const OsimModel model = read_osim(test::gait2392_model());
   const auto poses = body_poses(model);
   ASSERT_EQ(poses.size(), model.bodies.size());
   const Eigen::Vector3d hip = poses.at("femur_r").translation();
@@ -110,7 +106,7 @@ TEST(KinematicsTest, Gait2392DefaultPoseStacksTheLegBelowTheHip) {
 }
 
 TEST(KinematicsTest, Gait2392KneeFlexionFollowsItsCoupledTranslations) {
-  const OsimModel model = read_osim(gait2392());
+  const OsimModel model = read_osim(test::gait2392_model());
   const double flexion = -std::numbers::pi / 2;  // gait2392: knee_angle_r is negative in flexion
   const auto straight = body_poses(model, {{"knee_angle_r", 0.0}});
   const auto bent = body_poses(model, {{"knee_angle_r", flexion}});

@@ -10,24 +10,14 @@
 
 #include "core/errors.h"
 #include "tests/support/test_data.h"
+#include "tests/support/test_helpers.h"
 
 namespace mmm::opensim {
 namespace {
 
 using ::testing::HasSubstr;
 
-std::filesystem::path pipelines() { return test::data_dir() / "gait2392" / "Pipelines"; }
-
-// The message of the IoError `parse` throws; "" when it throws nothing.
-template <typename F>
-std::string io_error_of(F&& parse) {
-  try {
-    parse();
-  } catch (const IoError& error) {
-    return error.what();
-  }
-  return {};
-}
+using test::io_error_of;
 
 // <OpenSimDocument><MarkerSet><objects> around `markers`; the first marker
 // element starts on line 4.
@@ -201,17 +191,18 @@ TEST(MarkerSetTest, RejectsBadIkTasks) {
 }
 
 TEST(MarkerSetTest, RejectsMissingFiles) {
-  EXPECT_THAT(io_error_of([] { (void)read_marker_set(pipelines() / "absent.xml"); }),
+  EXPECT_THAT(io_error_of([] { (void)read_marker_set(test::gait2392_pipelines() / "absent.xml"); }),
               HasSubstr("absent.xml: no such file"));
-  EXPECT_THAT(io_error_of([] { (void)read_ik_task_weights(pipelines() / "absent_ik.xml"); }),
-              HasSubstr("absent_ik.xml: no such file"));
+  EXPECT_THAT(
+      io_error_of([] { (void)read_ik_task_weights(test::gait2392_pipelines() / "absent_ik.xml"); }),
+      HasSubstr("absent_ik.xml: no such file"));
 }
 
 // --- Real data -------------------------------------------------------------
 
 TEST(MarkerSetTest, ReadsTheGait2392ScaleMarkerSet) {
   const std::vector<MarkerDefinition> markers =
-      read_marker_set(pipelines() / "gait2392_Scale_MarkerSet.xml");
+      read_marker_set(test::gait2392_pipelines() / "gait2392_Scale_MarkerSet.xml");
   ASSERT_EQ(markers.size(), 39U);
   EXPECT_EQ(markers.front().name, "Sternum");
   EXPECT_EQ(markers.front().body, "torso");
@@ -237,7 +228,7 @@ TEST(MarkerSetTest, ReadsTheGait2392ScaleMarkerSet) {
 
 TEST(MarkerSetTest, ReadsTheSubjectIkWeights) {
   const std::map<std::string, IkMarkerWeight> weights =
-      read_ik_task_weights(pipelines() / "subject01_Setup_IK.xml");
+      read_ik_task_weights(test::gait2392_pipelines() / "subject01_Setup_IK.xml");
   ASSERT_EQ(weights.size(), 31U);
   EXPECT_EQ(weights.at("R.ASIS").weight, 10.0);
   EXPECT_EQ(weights.at("V.Sacral").weight, 10.0);

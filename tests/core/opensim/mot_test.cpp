@@ -4,33 +4,23 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <string>
 
 #include "core/errors.h"
 #include "tests/support/test_data.h"
+#include "tests/support/test_helpers.h"
 
 namespace mmm::opensim {
 namespace {
 
 using ::testing::HasSubstr;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using test::io_error_of;
+using test::kNaN;
 
 std::filesystem::path ik_result() {
   return test::data_dir() / "gait2392" / "Pipelines" / "reference" / "subject01_walk1_ik.mot";
-}
-
-// The message of the IoError `parse` throws; "" when it throws nothing.
-template <typename F>
-std::string io_error_of(F&& parse) {
-  try {
-    parse();
-  } catch (const IoError& error) {
-    return error.what();
-  }
-  return {};
 }
 
 // OpenSim 4 layout, 3 rows; the labels are on line 7, the rows on 8-10.

@@ -16,7 +16,7 @@ namespace {
 
 // Values of order 1 computed through a few dozen flops: double round-off
 // stays below 1e-12.
-constexpr double kRoundOff = 1e-12;
+constexpr double kSplineRoundOff = 1e-12;
 
 std::vector<double> sample_range(double lo, double hi, int count) {
   std::vector<double> xs;
@@ -37,7 +37,7 @@ TEST(SimmSplineTest, ReproducesCubicFromUnevenPoints) {
   const SimmSpline spline(x, y);
   for (const double t : sample_range(-1.0, 2.0, 61)) {
     // |f| <= 16 on [-1, 2]: scale the round-off bound.
-    EXPECT_NEAR(spline.evaluate(t), f(t), 16 * kRoundOff) << "x = " << t;
+    EXPECT_NEAR(spline.evaluate(t), f(t), 16 * kSplineRoundOff) << "x = " << t;
     EXPECT_NEAR(spline.derivative(t), df(t), 1e-10) << "x = " << t;  // |f'| <= 21, solve noise
   }
 }
@@ -47,7 +47,7 @@ TEST(SimmSplineTest, ReproducesQuadraticFromThreePoints) {
   const auto f = [](double x) { return 3.0 * x * x - 2.0 * x + 0.25; };
   const SimmSpline spline({0.0, 0.3, 1.0}, {f(0.0), f(0.3), f(1.0)});
   for (const double t : sample_range(0.0, 1.0, 21)) {
-    EXPECT_NEAR(spline.evaluate(t), f(t), kRoundOff) << "x = " << t;
+    EXPECT_NEAR(spline.evaluate(t), f(t), kSplineRoundOff) << "x = " << t;
     EXPECT_NEAR(spline.derivative(t), 6.0 * t - 2.0, 1e-11) << "x = " << t;  // slope ~ 4
   }
 }
@@ -59,8 +59,8 @@ TEST(SimmSplineTest, LinearDataGivesStraightLine) {
   for (const double xi : x) y.push_back(0.5 * xi - 0.2);
   const SimmSpline spline(x, y);
   for (const double t : sample_range(-3.0, 4.0, 71)) {  // includes the extrapolated ends
-    EXPECT_NEAR(spline.evaluate(t), 0.5 * t - 0.2, kRoundOff) << "x = " << t;
-    EXPECT_NEAR(spline.derivative(t), 0.5, kRoundOff) << "x = " << t;
+    EXPECT_NEAR(spline.evaluate(t), 0.5 * t - 0.2, kSplineRoundOff) << "x = " << t;
+    EXPECT_NEAR(spline.derivative(t), 0.5, kSplineRoundOff) << "x = " << t;
   }
 }
 
@@ -102,8 +102,8 @@ TEST(SimmSplineTest, ExtrapolatesAlongTheEndTangents) {
   const SimmSpline spline({0.0, 1.0, 2.0, 4.0}, {0.0, 1.0, 0.0, 2.0});
   const double slope_lo = spline.derivative(0.0);
   const double slope_hi = spline.derivative(4.0);
-  EXPECT_NEAR(spline.evaluate(-1.5), -1.5 * slope_lo, kRoundOff);
-  EXPECT_NEAR(spline.evaluate(6.0), 2.0 + 2.0 * slope_hi, kRoundOff);
+  EXPECT_NEAR(spline.evaluate(-1.5), -1.5 * slope_lo, kSplineRoundOff);
+  EXPECT_NEAR(spline.evaluate(6.0), 2.0 + 2.0 * slope_hi, kSplineRoundOff);
   EXPECT_EQ(spline.derivative(-1.5), slope_lo);
   EXPECT_EQ(spline.derivative(6.0), slope_hi);
 }
@@ -163,8 +163,8 @@ TEST(SimmSplineTest, MatchesDenseSolveOnGaitKneeSplines) {
   const SimmSpline t2(kKneeX2, kKneeY2);
   for (const double q : sample_range(-2.0944, 2.0944, 97)) {
     // Values ~0.4 m from two well-conditioned solves: agreement to round-off.
-    EXPECT_NEAR(t1.evaluate(q), dense_reference(kKneeX1, kKneeY1, q), kRoundOff) << q;
-    EXPECT_NEAR(t2.evaluate(q), dense_reference(kKneeX2, kKneeY2, q), kRoundOff) << q;
+    EXPECT_NEAR(t1.evaluate(q), dense_reference(kKneeX1, kKneeY1, q), kSplineRoundOff) << q;
+    EXPECT_NEAR(t2.evaluate(q), dense_reference(kKneeX2, kKneeY2, q), kSplineRoundOff) << q;
   }
 }
 
@@ -183,11 +183,11 @@ TEST(SimmSplineTest, GaitKneeSplineValuesCheckedByHand) {
   //   translation2(-pi/2) = -0.41399219775507551.
   // The decimal knots differ from their doubles by < 1e-17 relative, so the
   // double evaluation agrees to round-off.
-  EXPECT_NEAR(t1.evaluate(0.0), -0.0044998565175360132, kRoundOff);
-  EXPECT_NEAR(t2.evaluate(0.0), -0.39582069644835033, kRoundOff);
-  EXPECT_NEAR(t1.evaluate(-1.0), 0.0039252685084184957, kRoundOff);
-  EXPECT_NEAR(t2.evaluate(-1.0), -0.40480003999257308, kRoundOff);
-  EXPECT_NEAR(t2.evaluate(-std::numbers::pi / 2), -0.41399219775507551, kRoundOff);
+  EXPECT_NEAR(t1.evaluate(0.0), -0.0044998565175360132, kSplineRoundOff);
+  EXPECT_NEAR(t2.evaluate(0.0), -0.39582069644835033, kSplineRoundOff);
+  EXPECT_NEAR(t1.evaluate(-1.0), 0.0039252685084184957, kSplineRoundOff);
+  EXPECT_NEAR(t2.evaluate(-1.0), -0.40480003999257308, kSplineRoundOff);
+  EXPECT_NEAR(t2.evaluate(-std::numbers::pi / 2), -0.41399219775507551, kSplineRoundOff);
 }
 
 TEST(SimmSplineTest, RejectsBadTables) {

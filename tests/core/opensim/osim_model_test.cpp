@@ -16,7 +16,7 @@ namespace mmm::opensim {
 namespace {
 
 // Offsets composed from a few products of numbers of order 1.
-constexpr double kRoundOff = 1e-12;
+constexpr double kOffsetRoundOff = 1e-12;
 
 // A small OpenSim 4 model touching every feature the reader extracts.
 const std::string kTinyModel = R"(<?xml version="1.0" encoding="UTF-8" ?>
@@ -261,7 +261,8 @@ TEST(OsimModelTest, ResolvesOffsetFramesAndCoordinates) {
   const Joint* knee = model.find_joint("knee");
   ASSERT_NE(knee, nullptr);
   EXPECT_EQ(knee->parent.body, "thigh");
-  EXPECT_NEAR((knee->parent.translation - Eigen::Vector3d(0, -0.4, 0)).norm(), 0.0, kRoundOff);
+  EXPECT_NEAR((knee->parent.translation - Eigen::Vector3d(0, -0.4, 0)).norm(), 0.0,
+              kOffsetRoundOff);
   EXPECT_EQ(knee->child.body, "shank");
   EXPECT_EQ(model.find_coordinate("knee_angle")->motion_type, MotionType::kRotational);
   EXPECT_EQ(model.find_coordinate("knee_angle")->range, (std::array<double, 2>{-2, 0.2}));
@@ -275,12 +276,12 @@ TEST(OsimModelTest, ResolvesOffsetFramesAndCoordinates) {
   const Eigen::Matrix3d r2 = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).matrix();
   EXPECT_NEAR(
       (marker->frame.translation - Eigen::Vector3d(std::cos(0.5), 1 + std::sin(0.5), 0)).norm(),
-      0.0, kRoundOff);
-  EXPECT_NEAR((marker->frame.rotation() - r1 * r2).norm(), 0.0, kRoundOff);
+      0.0, kOffsetRoundOff);
+  EXPECT_NEAR((marker->frame.rotation() - r1 * r2).norm(), 0.0, kOffsetRoundOff);
   EXPECT_NEAR((marker->frame.to_body(marker->location) -
                (marker->frame.translation + r1 * r2 * Eigen::Vector3d(0, 1, 0)))
                   .norm(),
-              0.0, kRoundOff);
+              0.0, kOffsetRoundOff);
 }
 
 TEST(OsimModelTest, ReadsCustomJointSpatialTransform) {
@@ -331,7 +332,7 @@ TEST(OsimModelTest, ReadsMusclePathAndMarkers) {
   EXPECT_EQ(moving.z_coordinate, "knee_angle");
   EXPECT_DOUBLE_EQ(moving.x_location.evaluate(-1.0), 0.03);
   // Location at the default knee angle 0: (0.04, 0.03, 0.002).
-  EXPECT_NEAR((moving.location - Eigen::Vector3d(0.04, 0.03, 0.002)).norm(), 0.0, kRoundOff);
+  EXPECT_NEAR((moving.location - Eigen::Vector3d(0.04, 0.03, 0.002)).norm(), 0.0, kOffsetRoundOff);
   ASSERT_EQ(vasti->path_wraps.size(), 1U);
   EXPECT_EQ(vasti->path_wraps[0].wrap_object, "cyl");
   EXPECT_EQ(vasti->path_wraps[0].method, "midpoint");
@@ -359,7 +360,7 @@ TEST(OsimModelTest, ReadsOpenSim3Layout) {
   EXPECT_EQ(femur->geometry[0].mesh_file, "femur.vtp");
   // VisibleObject scale times DisplayGeometry scale.
   EXPECT_NEAR((femur->geometry[0].scale_factors - Eigen::Vector3d(1.1, 1.1, 2.2)).norm(), 0.0,
-              kRoundOff);
+              kOffsetRoundOff);
   ASSERT_EQ(femur->wrap_objects.size(), 1U);
   EXPECT_EQ(femur->wrap_objects[0].radius, 0.025);
 
@@ -485,16 +486,12 @@ TEST(OsimModelErrorTest, BadBooleanAndDuplicates) {
 
 // ---------------------------------------------------------------- real data
 
-std::filesystem::path gait2392() {
-  return test::data_dir() / "gait2392" / "gait2392_thelen2003muscle.osim";
-}
-
 std::filesystem::path subject01() {
   return test::data_dir() / "gait2392" / "Pipelines" / "reference" / "subject01_simbody.osim";
 }
 
 TEST(OsimModelRealDataTest, Gait2392BodiesJointsAndHeader) {
-  const OsimModel model = read_osim(gait2392());
+  const OsimModel model = read_osim(test::gait2392_model());
   EXPECT_EQ(model.version, 40000);
   EXPECT_EQ(model.name, "3DGaitModel2392");
   EXPECT_NE(model.credits.find("Delp"), std::string::npos);
@@ -516,7 +513,7 @@ TEST(OsimModelRealDataTest, Gait2392BodiesJointsAndHeader) {
   ASSERT_EQ(femur->geometry.size(), 1U);
   EXPECT_EQ(femur->geometry[0].mesh_file, "femur_r.vtp");
   EXPECT_EQ(femur->geometry[0].scale_factors, Eigen::Vector3d::Ones());
-  EXPECT_TRUE(std::filesystem::exists(gait2392().parent_path() / "Geometry" /
+  EXPECT_TRUE(std::filesystem::exists(test::gait2392_model().parent_path() / "Geometry" /
                                       femur->geometry[0].mesh_file));
 
   EXPECT_EQ(model.joints.size(), 12U);
@@ -545,7 +542,7 @@ TEST(OsimModelRealDataTest, Gait2392BodiesJointsAndHeader) {
 }
 
 TEST(OsimModelRealDataTest, Gait2392KneeHasCoupledTranslationSplines) {
-  const OsimModel model = read_osim(gait2392());
+  const OsimModel model = read_osim(test::gait2392_model());
   const Joint* knee = model.find_joint("knee_r");
   ASSERT_NE(knee, nullptr);
   EXPECT_EQ(knee->type, "CustomJoint");
@@ -572,7 +569,7 @@ TEST(OsimModelRealDataTest, Gait2392KneeHasCoupledTranslationSplines) {
 }
 
 TEST(OsimModelRealDataTest, Gait2392Muscles) {
-  const OsimModel model = read_osim(gait2392());
+  const OsimModel model = read_osim(test::gait2392_model());
   ASSERT_EQ(model.muscles.size(), 92U);
   std::size_t points = 0;
   std::size_t conditional = 0;

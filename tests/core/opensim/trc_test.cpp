@@ -6,7 +6,6 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <limits>
 #include <random>
 #include <string>
 #include <string_view>
@@ -15,26 +14,15 @@
 #include "core/errors.h"
 #include "core/opensim/marker_set.h"
 #include "tests/support/test_data.h"
+#include "tests/support/test_helpers.h"
 
 namespace mmm::opensim {
 namespace {
 
 using ::testing::HasSubstr;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::filesystem::path pipelines() { return test::data_dir() / "gait2392" / "Pipelines"; }
-
-// The message of the IoError `parse` throws; "" when it throws nothing.
-template <typename F>
-std::string io_error_of(F&& parse) {
-  try {
-    parse();
-  } catch (const IoError& error) {
-    return error.what();
-  }
-  return {};
-}
+using test::io_error_of;
+using test::kNaN;
 
 std::string fixed(double value, int decimals) {
   std::array<char, 64> buffer{};
@@ -345,14 +333,14 @@ TEST(TrcTest, RejectsBrokenHeaderLines) {
 
 TEST(TrcTest, RejectsAMissingFile) {
   const std::string message =
-      io_error_of([] { (void)read_trc(pipelines() / "no_such_trial.trc"); });
+      io_error_of([] { (void)read_trc(test::gait2392_pipelines() / "no_such_trial.trc"); });
   EXPECT_THAT(message, HasSubstr("no_such_trial.trc: no such file"));
 }
 
 // --- Real data -------------------------------------------------------------
 
 TEST(TrcTest, ReadsTheWalkingTrial) {
-  const MarkerTrajectories walk = read_trc(pipelines() / "subject01_walk1.trc");
+  const MarkerTrajectories walk = read_trc(test::gait2392_pipelines() / "subject01_walk1.trc");
   EXPECT_TRUE(walk.warnings.empty());
   EXPECT_EQ(walk.num_frames(), 151);
   EXPECT_EQ(walk.num_markers(), 41);
@@ -380,7 +368,7 @@ TEST(TrcTest, ReadsTheWalkingTrial) {
 }
 
 TEST(TrcTest, ReadsTheStaticTrial) {
-  const MarkerTrajectories still = read_trc(pipelines() / "subject01_static.trc");
+  const MarkerTrajectories still = read_trc(test::gait2392_pipelines() / "subject01_static.trc");
   EXPECT_TRUE(still.warnings.empty());
   EXPECT_EQ(still.num_frames(), 300);
   EXPECT_EQ(still.num_markers(), 49);
@@ -393,19 +381,20 @@ TEST(TrcTest, ReadsTheStaticTrial) {
 }
 
 TEST(TrcTest, TrialsCarryEveryMarkerTheSetupsUse) {
-  const MarkerTrajectories still = read_trc(pipelines() / "subject01_static.trc");
+  const MarkerTrajectories still = read_trc(test::gait2392_pipelines() / "subject01_static.trc");
   for (const MarkerDefinition& marker :
-       read_marker_set(pipelines() / "gait2392_Scale_MarkerSet.xml")) {
+       read_marker_set(test::gait2392_pipelines() / "gait2392_Scale_MarkerSet.xml")) {
     EXPECT_TRUE(still.marker_index(marker.name).has_value()) << marker.name;
   }
-  const MarkerTrajectories walk = read_trc(pipelines() / "subject01_walk1.trc");
-  for (const auto& task : read_ik_task_weights(pipelines() / "subject01_Setup_IK.xml")) {
+  const MarkerTrajectories walk = read_trc(test::gait2392_pipelines() / "subject01_walk1.trc");
+  for (const auto& task :
+       read_ik_task_weights(test::gait2392_pipelines() / "subject01_Setup_IK.xml")) {
     EXPECT_TRUE(walk.marker_index(task.first).has_value()) << task.first;
   }
 }
 
 TEST(TrcTest, WalkingTrialSurvivesARoundTrip) {
-  const MarkerTrajectories walk = read_trc(pipelines() / "subject01_walk1.trc");
+  const MarkerTrajectories walk = read_trc(test::gait2392_pipelines() / "subject01_walk1.trc");
   test::ScratchDir scratch("trc-walk");
   write_trc(walk, scratch / "walk.trc");
   const MarkerTrajectories back = read_trc(scratch / "walk.trc");

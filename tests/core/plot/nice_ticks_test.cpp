@@ -10,13 +10,14 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "tests/support/test_helpers.h"
 
 namespace mmm::plot {
 namespace {
 
 using ::testing::ElementsAre;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using test::kNaN;
 
 TEST(NiceTicksTest, KnownRanges) {
   EXPECT_THAT(nice_ticks(0, 97), ElementsAre(0, 20, 40, 60, 80, 100));

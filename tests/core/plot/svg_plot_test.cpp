@@ -21,6 +21,7 @@
 
 #include "core/errors.h"
 #include "tests/support/test_data.h"
+#include "tests/support/test_helpers.h"
 
 namespace mmm::plot {
 namespace {
@@ -28,7 +29,7 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using test::kNaN;
 
 // Coordinates are written with 2 decimals: each number read back is within
 // 0.005 px of the exact value, so a difference of two is within 0.01.

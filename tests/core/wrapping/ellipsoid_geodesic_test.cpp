@@ -15,6 +15,7 @@
 #include "core/motion/skeleton.h"
 #include "core/wrapping/action_line_path.h"
 #include "core/wrapping/obstacle_set.h"
+#include "tests/support/test_helpers.h"
 #include "tests/support/toy_leg_atlas.h"
 
 namespace mmm::wrapping {
@@ -22,12 +23,7 @@ namespace {
 
 using Eigen::Vector3d;
 
-Eigen::Isometry3d some_pose(const Vector3d& centre) {
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translation() = centre;
-  pose.linear() = Eigen::AngleAxisd(0.4, Vector3d(1, 1, 0).normalized()).matrix();
-  return pose;
-}
+using test::tilted_pose;
 
 Obstacle ellipsoid_at(const Eigen::Isometry3d& pose, const Vector3d& radii) {
   Obstacle obstacle;
@@ -37,7 +33,7 @@ Obstacle ellipsoid_at(const Eigen::Isometry3d& pose, const Vector3d& radii) {
   return obstacle;
 }
 
-Obstacle sphere_at(const Eigen::Isometry3d& pose, double radius) {
+Obstacle geodesic_sphere_at(const Eigen::Isometry3d& pose, double radius) {
   Obstacle obstacle;
   obstacle.pose = pose;
   obstacle.radius = radius;
@@ -57,12 +53,12 @@ Vector3d normal_at(const Obstacle& ellipsoid, const Vector3d& world) {
 }
 
 TEST(EllipsoidGeodesicTest, EqualRadiiGiveTheSpheresGreatCircle) {
-  const Eigen::Isometry3d pose = some_pose(Vector3d(10, 20, 30));
+  const Eigen::Isometry3d pose = tilted_pose(Vector3d(10, 20, 30));
   const Vector3d p = pose.translation() + Vector3d(-80, -20, 10);
   const Vector3d s = pose.translation() + Vector3d(90, -25, -5);
   for (const char* quadrant : {"all", "+y"}) {
     Obstacle ellipsoid = ellipsoid_at(pose, Vector3d(40, 40, 40));
-    Obstacle sphere = sphere_at(pose, 40.0);
+    Obstacle sphere = geodesic_sphere_at(pose, 40.0);
     ellipsoid.quadrant = sphere.quadrant = quadrant;
     const WrapResult numeric = wrap_segment(p, s, ellipsoid);
     const WrapResult exact = wrap_segment(p, s, sphere);
@@ -84,7 +80,7 @@ TEST(EllipsoidGeodesicTest, EqualRadiiGiveTheSpheresGreatCircle) {
 
 TEST(EllipsoidGeodesicTest, AProlateWrapIsAShortestPathBetweenItsSpheresBounds) {
   const Vector3d radii(25, 25, 60);
-  const Obstacle ellipsoid = ellipsoid_at(some_pose(Vector3d(5, -7, 100)), radii);
+  const Obstacle ellipsoid = ellipsoid_at(tilted_pose(Vector3d(5, -7, 100)), radii);
   const Vector3d p = ellipsoid.pose * Vector3d(-90, -8, 40);
   const Vector3d s = ellipsoid.pose * Vector3d(95, -6, -45);
   WrapOptions fine;
@@ -95,8 +91,8 @@ TEST(EllipsoidGeodesicTest, AProlateWrapIsAShortestPathBetweenItsSpheresBounds) 
   // Outside the inscribed sphere (r 25) and inside the circumscribed one
   // (r 60), both of which the straight line crosses: the shortest paths
   // around them bound this one.
-  const WrapResult inner = wrap_segment(p, s, sphere_at(ellipsoid.pose, radii.minCoeff()));
-  const WrapResult outer = wrap_segment(p, s, sphere_at(ellipsoid.pose, radii.maxCoeff()));
+  const WrapResult inner = wrap_segment(p, s, geodesic_sphere_at(ellipsoid.pose, radii.minCoeff()));
+  const WrapResult outer = wrap_segment(p, s, geodesic_sphere_at(ellipsoid.pose, radii.maxCoeff()));
   ASSERT_TRUE(inner.wrapped);
   ASSERT_TRUE(outer.wrapped);
   EXPECT_GT(wrap.length, inner.length);
@@ -136,7 +132,7 @@ TEST(EllipsoidGeodesicTest, AProlateWrapIsAShortestPathBetweenItsSpheresBounds) 
 }
 
 TEST(EllipsoidGeodesicTest, MissesStayStraightInsidePointsAreFlaggedBadRadiiAreErrors) {
-  const Obstacle ellipsoid = ellipsoid_at(some_pose(Vector3d::Zero()), Vector3d(10, 20, 30));
+  const Obstacle ellipsoid = ellipsoid_at(tilted_pose(Vector3d::Zero()), Vector3d(10, 20, 30));
   const WrapResult miss = wrap_segment(Vector3d(-100, 0, 60), Vector3d(100, 0, 60), ellipsoid);
   EXPECT_FALSE(miss.wrapped);
   EXPECT_DOUBLE_EQ(miss.length, 200.0);

@@ -15,6 +15,7 @@
 #include "core/errors.h"
 #include "core/mesh/primitives.h"
 #include "core/wrapping/obstacle_set.h"
+#include "tests/support/test_helpers.h"
 
 namespace mmm::wrapping {
 namespace {
@@ -22,13 +23,13 @@ namespace {
 using Eigen::Vector3d;
 using ::testing::HasSubstr;
 
-constexpr double kRadius = 30.0;
+constexpr double kObstacleRadius = 30.0;
 constexpr double kClearance = 1.0;
 
 // An icosphere of 20480 faces: its flat faces lie up to ~0.006 mm inside the
 // sphere through its vertices (triangles of circumradius ~0.6 mm on 30 mm).
 const mesh::SignedDistance& sphere_sdf() {
-  static const mesh::SignedDistance sdf(mesh::make_icosphere(5, kRadius));
+  static const mesh::SignedDistance sdf(mesh::make_icosphere(5, kObstacleRadius));
   return sdf;
 }
 
@@ -37,28 +38,18 @@ const mesh::SignedDistance& sphere_sdf() {
 // inside the circle.
 const mesh::SignedDistance& cylinder_sdf() {
   static const mesh::SignedDistance sdf = [] {
-    mesh::IndexedMesh mesh = mesh::make_cylinder(kRadius, 300.0, 256);
+    mesh::IndexedMesh mesh = mesh::make_cylinder(kObstacleRadius, 300.0, 256);
     mesh.V.col(2).array() -= 150.0;
     return mesh::SignedDistance(mesh);
   }();
   return sdf;
 }
 
-Eigen::Isometry3d some_pose(const Vector3d& translation) {
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translation() = translation;
-  pose.linear() = Eigen::AngleAxisd(0.4, Vector3d(1, 1, 0).normalized()).matrix();
-  return pose;
-}
-
-double polyline_length(const std::vector<Vector3d>& points) {
-  double length = 0;
-  for (std::size_t i = 1; i < points.size(); ++i) length += (points[i] - points[i - 1]).norm();
-  return length;
-}
+using test::polyline_length;
+using test::tilted_pose;
 
 TEST(GlobalPathTest, AStraightSegmentThatMissesTheObstacleStaysStraight) {
-  const PosedSurface sphere{&sphere_sdf(), some_pose(Vector3d(10, 20, 30))};
+  const PosedSurface sphere{&sphere_sdf(), tilted_pose(Vector3d(10, 20, 30))};
   const Vector3d a = sphere.pose * Vector3d(-100, 45, 0);
   const Vector3d b = sphere.pose * Vector3d(100, 45, 0);
   const GlobalSegment segment = global_segment(a, b, {sphere});
@@ -75,7 +66,7 @@ TEST(GlobalPathTest, AStraightSegmentThatMissesTheObstacleStaysStraight) {
 }
 
 TEST(GlobalPathTest, ASegmentThroughASphereMeshWrapsAlongTheGreatCircle) {
-  const PosedSurface sphere{&sphere_sdf(), some_pose(Vector3d(10, 20, 30))};
+  const PosedSurface sphere{&sphere_sdf(), tilted_pose(Vector3d(10, 20, 30))};
   const Vector3d c = sphere.pose.translation();
   // Ends close to the sphere on either side: a wrap of ~85 degrees.
   const Vector3d a = c + Vector3d(-40, -5, 3);
@@ -83,7 +74,7 @@ TEST(GlobalPathTest, ASegmentThroughASphereMeshWrapsAlongTheGreatCircle) {
   const GlobalSegment segment = global_segment(a, b, {sphere});
   Obstacle inflated;
   inflated.pose = sphere.pose;
-  inflated.radius = kRadius + kClearance;
+  inflated.radius = kObstacleRadius + kClearance;
   const WrapResult analytic = wrap_segment(a, b, inflated);
   ASSERT_TRUE(analytic.wrapped);
   EXPECT_TRUE(segment.converged);
@@ -98,20 +89,20 @@ TEST(GlobalPathTest, ASegmentThroughASphereMeshWrapsAlongTheGreatCircle) {
   EXPECT_GT(analytic.wrap_angle, 1.2);
   // Clear of the sphere by the clearance, but for the facets (~0.006 mm).
   for (const Vector3d& point : segment.points) {
-    EXPECT_GE((point - c).norm(), kRadius + kClearance - 1e-2);
+    EXPECT_GE((point - c).norm(), kObstacleRadius + kClearance - 1e-2);
   }
   EXPECT_NEAR(segment.max_penetration, -kClearance, 1e-6);
 }
 
 TEST(GlobalPathTest, ASegmentAcrossACylinderMeshWrapsAlongTheHelix) {
-  const PosedSurface cylinder{&cylinder_sdf(), some_pose(Vector3d(5, -7, 100))};
+  const PosedSurface cylinder{&cylinder_sdf(), tilted_pose(Vector3d(5, -7, 100))};
   const Vector3d a = cylinder.pose * Vector3d(-60, -25, -40);
   const Vector3d b = cylinder.pose * Vector3d(70, -20, 55);
   const GlobalSegment segment = global_segment(a, b, {cylinder});
   Obstacle inflated;
   inflated.shape = ObstacleShape::kCylinder;
   inflated.pose = cylinder.pose;
-  inflated.radius = kRadius + kClearance;
+  inflated.radius = kObstacleRadius + kClearance;
   const WrapResult analytic = wrap_segment(a, b, inflated);
   ASSERT_TRUE(analytic.wrapped);
   EXPECT_TRUE(segment.converged);
@@ -122,12 +113,12 @@ TEST(GlobalPathTest, ASegmentAcrossACylinderMeshWrapsAlongTheHelix) {
   // Clear of the cylinder by the clearance, but for the facets (0.0023 mm).
   const Eigen::Isometry3d to_local = cylinder.pose.inverse();
   for (const Vector3d& point : segment.points) {
-    EXPECT_GE((to_local * point).head<2>().norm(), kRadius + kClearance - 3e-3);
+    EXPECT_GE((to_local * point).head<2>().norm(), kObstacleRadius + kClearance - 3e-3);
   }
 }
 
 TEST(GlobalPathTest, AWarmStartFromThePreviousFrameConvergesInFewerIterations) {
-  const PosedSurface sphere{&sphere_sdf(), some_pose(Vector3d(10, 20, 30))};
+  const PosedSurface sphere{&sphere_sdf(), tilted_pose(Vector3d(10, 20, 30))};
   const Vector3d c = sphere.pose.translation();
   const Vector3d a = c + Vector3d(-80, -20, 10);
   const GlobalSegment previous = global_segment(a, c + Vector3d(90, -25, -5), {sphere});
@@ -144,7 +135,7 @@ TEST(GlobalPathTest, AWarmStartFromThePreviousFrameConvergesInFewerIterations) {
 }
 
 TEST(GlobalPathTest, AFixedPointInsideASurfaceIsReportedAndThePathLeavesItAlongTheGradient) {
-  const PosedSurface sphere{&sphere_sdf(), some_pose(Vector3d(10, 20, 30))};
+  const PosedSurface sphere{&sphere_sdf(), tilted_pose(Vector3d(10, 20, 30))};
   const Vector3d c = sphere.pose.translation();
   const Vector3d inside = c + Vector3d(0, 12, 0);
   const Vector3d outside = c + Vector3d(20, 90, 0);
@@ -156,7 +147,7 @@ TEST(GlobalPathTest, AFixedPointInsideASurfaceIsReportedAndThePathLeavesItAlongT
   // The lift: radially out to the inflated sphere (the icosphere's facets
   // are within ~0.005 mm of it).
   ASSERT_GE(segment.points.size(), 3u);
-  EXPECT_NEAR((segment.points[1] - c).norm(), kRadius + kClearance, 1e-2);
+  EXPECT_NEAR((segment.points[1] - c).norm(), kObstacleRadius + kClearance, 1e-2);
   EXPECT_NEAR((segment.points[1] - c).normalized().dot((inside - c).normalized()), 1.0, 1e-4);
   EXPECT_GE(segment.length, (outside - inside).norm());
   // Whole paths report it too, at the segment that starts there.
@@ -167,7 +158,7 @@ TEST(GlobalPathTest, AFixedPointInsideASurfaceIsReportedAndThePathLeavesItAlongT
 }
 
 TEST(GlobalPathTest, AWholePathIsItsSegmentsEndToEnd) {
-  const PosedSurface sphere{&sphere_sdf(), some_pose(Vector3d(10, 20, 30))};
+  const PosedSurface sphere{&sphere_sdf(), tilted_pose(Vector3d(10, 20, 30))};
   const Vector3d c = sphere.pose.translation();
   const std::vector<Vector3d> fixed = {c + Vector3d(-80, -20, 10), c + Vector3d(90, -25, -5),
                                        c + Vector3d(90, 60, 0)};
@@ -191,7 +182,7 @@ TEST(GlobalPathTest, AWholePathIsItsSegmentsEndToEnd) {
 }
 
 TEST(GlobalPathTest, OnlySurfacesNearTheSegmentAreQueried) {
-  const PosedSurface near{&sphere_sdf(), some_pose(Vector3d(0, 0, 0))};
+  const PosedSurface near{&sphere_sdf(), tilted_pose(Vector3d(0, 0, 0))};
   const PosedSurface far{&sphere_sdf(), Eigen::Isometry3d(Eigen::Translation3d(500, 0, 0))};
   const std::vector<Vector3d> line = {Vector3d(-100, 0, 0), Vector3d(100, 0, 0)};
   EXPECT_EQ(surfaces_near(line, {near, far}, 10.0), std::vector<int>{0});
@@ -199,7 +190,7 @@ TEST(GlobalPathTest, OnlySurfacesNearTheSegmentAreQueried) {
   EXPECT_EQ(surfaces_near(line, {near, far}, 380.0), (std::vector<int>{0, 1}));
   const Eigen::AlignedBox3d box = world_bounds(far);
   EXPECT_TRUE(box.contains(Vector3d(500, 0, 0)));
-  EXPECT_GT(box.sizes().minCoeff(), 2.0 * kRadius - 1e-9);
+  EXPECT_GT(box.sizes().minCoeff(), 2.0 * kObstacleRadius - 1e-9);
   const GlobalSegment segment = global_segment(line[0], line[1], {near, far});
   EXPECT_EQ(segment.surfaces, std::vector<int>{0});
   EXPECT_TRUE(segment.touches);

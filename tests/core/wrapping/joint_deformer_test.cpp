@@ -22,7 +22,7 @@ using Eigen::MatrixX3d;
 using Eigen::RowVector3d;
 using Eigen::Vector3d;
 
-constexpr double kRadius = 20.0;
+constexpr double kJointSphereRadius = 20.0;
 constexpr double kBone = 12.0;  // a half-space bone: y > kBone
 
 // A body whose skeleton carries its rest surface to `targets` (no rotation),
@@ -48,7 +48,7 @@ JointOptions options() {
 }
 
 TEST(JointDeformerTest, TwoSpheresCarriedIntoEachOtherMeetHalfwayKeepingTheirVolumes) {
-  const mesh::IndexedMesh rest = mesh::make_icosphere(4, kRadius);
+  const mesh::IndexedMesh rest = mesh::make_icosphere(4, kJointSphereRadius);
   const VolumeDeformer deformer(rest);
   // Centres 36 mm apart: 4 mm of overlap along x.
   const MatrixX3d left = rest.V.rowwise() + RowVector3d(-18, 0, 0);
@@ -86,12 +86,12 @@ TEST(JointDeformerTest, ADiscPressedBetweenTwoSpheresEntersNeither) {
   // Half-axes 20 x 20 x 4 mm, each sphere carried 3.5 mm into it from
   // either side: one-sided pins push the disc out of one sphere into the
   // other, round after round.
-  const mesh::IndexedMesh sphere = mesh::make_icosphere(4, kRadius);
+  const mesh::IndexedMesh sphere = mesh::make_icosphere(4, kJointSphereRadius);
   mesh::IndexedMesh disc = mesh::make_icosphere(4, 1.0);
   disc.V = disc.V * Vector3d(20, 20, 4).asDiagonal();
   const VolumeDeformer sphere_deformer(sphere);
   const VolumeDeformer disc_deformer(disc);
-  const double offset = 4.0 + kRadius - 3.5;
+  const double offset = 4.0 + kJointSphereRadius - 3.5;
   const std::vector<JointBody> bodies = {
       body(disc_deformer, disc.V),
       body(sphere_deformer, sphere.V.rowwise() + RowVector3d(0, 0, offset)),
@@ -109,7 +109,7 @@ TEST(JointDeformerTest, ADiscPressedBetweenTwoSpheresEntersNeither) {
 }
 
 TEST(JointDeformerTest, BodiesThatDoNotTouchAreLeftAlone) {
-  const mesh::IndexedMesh rest = mesh::make_icosphere(3, kRadius);
+  const mesh::IndexedMesh rest = mesh::make_icosphere(3, kJointSphereRadius);
   const VolumeDeformer deformer(rest);
   const std::vector<JointBody> bodies = {body(deformer, rest.V.rowwise() + RowVector3d(-25, 0, 0)),
                                          body(deformer, rest.V.rowwise() + RowVector3d(25, 0, 0))};
@@ -127,7 +127,7 @@ TEST(JointDeformerTest, PinsAndNewContactsHoldInTheJointSolve) {
   // The left sphere's vertex furthest from the overlap is pinned 1 mm out;
   // a "bone" (the half-space y > 12) takes in the right sphere's top, which
   // its query pushes back out.
-  const mesh::IndexedMesh rest = mesh::make_icosphere(4, kRadius);
+  const mesh::IndexedMesh rest = mesh::make_icosphere(4, kJointSphereRadius);
   const VolumeDeformer deformer(rest);
   std::vector<JointBody> bodies = {body(deformer, rest.V.rowwise() + RowVector3d(-18, 0, 0)),
                                    body(deformer, rest.V.rowwise() + RowVector3d(18, 0, 0))};
@@ -153,7 +153,7 @@ TEST(JointDeformerTest, PinsAndNewContactsHoldInTheJointSolve) {
 }
 
 TEST(JointDeformerTest, BadInputIsRefusedWithTheReason) {
-  const mesh::IndexedMesh rest = mesh::make_icosphere(2, kRadius);
+  const mesh::IndexedMesh rest = mesh::make_icosphere(2, kJointSphereRadius);
   const VolumeDeformer deformer(rest);
   const JointBody good = body(deformer, rest.V);
   auto message = [](const std::vector<JointBody>& bodies, const JointOptions& o) {

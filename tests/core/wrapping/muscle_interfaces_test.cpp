@@ -17,11 +17,11 @@
 namespace mmm::wrapping {
 namespace {
 
-constexpr double kRadius = 10.0;
+constexpr double kInterfaceSphereRadius = 10.0;
 constexpr double kReach = 5.0;
 
-mesh::IndexedMesh sphere_at(const Eigen::Vector3d& centre) {
-  mesh::IndexedMesh sphere = mesh::make_icosphere(3, kRadius);
+mesh::IndexedMesh interface_sphere_at(const Eigen::Vector3d& centre) {
+  mesh::IndexedMesh sphere = mesh::make_icosphere(3, kInterfaceSphereRadius);
   sphere.V.rowwise() += centre.transpose();
   return sphere;
 }
@@ -45,8 +45,8 @@ Eigen::Index extreme_vertex(const mesh::IndexedMesh& surface, double direction) 
 class MuscleInterfacesTest : public ::testing::Test {
  protected:
   // A at the origin, B touching it at (10, 0, 0).
-  mesh::IndexedMesh a = sphere_at({0, 0, 0});
-  mesh::IndexedMesh b = sphere_at({2 * kRadius, 0, 0});
+  mesh::IndexedMesh a = interface_sphere_at({0, 0, 0});
+  mesh::IndexedMesh b = interface_sphere_at({2 * kInterfaceSphereRadius, 0, 0});
   MuscleSurfaces rest{{a.V, b.V}, {&a.F, &b.F}, 2};
   std::vector<std::vector<InterfaceLink>> links = muscle_interfaces(rest, kReach, 2);
 };
@@ -104,9 +104,9 @@ TEST_F(MuscleInterfacesTest, TouchingMusclesDrivenApartMeetWhereTheyTouch) {
 TEST_F(MuscleInterfacesTest, ARigidMotionOfTheNeighbourIsCarriedExactly) {
   // B turns 30 degrees about z through its centre; A stays.
   Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
-  turn.translate(Eigen::Vector3d(2 * kRadius, 0, 0));
+  turn.translate(Eigen::Vector3d(2 * kInterfaceSphereRadius, 0, 0));
   turn.rotate(Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitZ()));
-  turn.translate(Eigen::Vector3d(-2 * kRadius, 0, 0));
+  turn.translate(Eigen::Vector3d(-2 * kInterfaceSphereRadius, 0, 0));
   const MuscleBinding::Targets still = moved(a, Eigen::Isometry3d::Identity());
   const MuscleBinding::Targets turned = moved(b, turn);
   const std::vector<const MuscleBinding::Targets*> all = {&still, &turned};
@@ -130,7 +130,7 @@ TEST_F(MuscleInterfacesTest, AttachmentsKeepTheirOwnMotion) {
 }
 
 TEST(MuscleInterfacesErrorsTest, ABadReachIsRefused) {
-  const mesh::IndexedMesh a = sphere_at({0, 0, 0});
+  const mesh::IndexedMesh a = interface_sphere_at({0, 0, 0});
   const MuscleSurfaces one({a.V}, {&a.F}, 1);
   EXPECT_THROW((void)muscle_interfaces(one, 0.0, 1), InvalidInputError);
   EXPECT_THROW((void)muscle_interfaces(one, std::nan(""), 1), InvalidInputError);

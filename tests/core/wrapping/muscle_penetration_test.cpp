@@ -18,10 +18,10 @@
 namespace mmm::wrapping {
 namespace {
 
-constexpr double kRadius = 10.0;
+constexpr double kPenetrationSphereRadius = 10.0;
 
-mesh::IndexedMesh sphere_at(const Eigen::Vector3d& centre) {
-  mesh::IndexedMesh sphere = mesh::make_icosphere(3, kRadius);
+mesh::IndexedMesh penetration_sphere_at(const Eigen::Vector3d& centre) {
+  mesh::IndexedMesh sphere = mesh::make_icosphere(3, kPenetrationSphereRadius);
   sphere.V.rowwise() += centre.transpose();
   return sphere;
 }
@@ -32,8 +32,8 @@ MuscleSurfaces surfaces_of(const mesh::IndexedMesh& a, const mesh::IndexedMesh& 
 
 TEST(MusclePenetrationTest, TheRestOverlapIsMeasuredAndNotCounted) {
   // Two spheres 15 mm apart overlap by 5 mm.
-  const mesh::IndexedMesh a = sphere_at({0, 0, 0});
-  const mesh::IndexedMesh b = sphere_at({15, 0, 0});
+  const mesh::IndexedMesh a = penetration_sphere_at({0, 0, 0});
+  const mesh::IndexedMesh b = penetration_sphere_at({15, 0, 0});
   const MuscleSurfaces rest = surfaces_of(a, b);
   const RestOverlap overlap = rest_overlap(0, a.V, rest);
   ASSERT_EQ(overlap.size(), 1U);
@@ -52,8 +52,8 @@ TEST(MusclePenetrationTest, TheRestOverlapIsMeasuredAndNotCounted) {
 }
 
 TEST(MusclePenetrationTest, AMuscleMovedDeeperIsMeasuredByHowMuchDeeper) {
-  const mesh::IndexedMesh a = sphere_at({0, 0, 0});
-  const mesh::IndexedMesh b = sphere_at({15, 0, 0});
+  const mesh::IndexedMesh a = penetration_sphere_at({0, 0, 0});
+  const mesh::IndexedMesh b = penetration_sphere_at({15, 0, 0});
   const RestOverlap overlap = rest_overlap(0, a.V, surfaces_of(a, b));
   mesh::IndexedMesh moved = a;
   moved.V.col(0).array() += 2.0;  // A moves 2 mm into B
@@ -74,7 +74,7 @@ TEST(MusclePenetrationTest, AWrappedTrialGetsTheMetricPerMuscleFrame) {
   wrapped.times = Eigen::VectorXd::LinSpaced(2, 0.0, 0.01);
   for (const Eigen::Vector3d& centre : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(15, 0, 0)}) {
     WrappedMuscle muscle;
-    muscle.rest = sphere_at(centre);
+    muscle.rest = penetration_sphere_at(centre);
     // Frame 0: as at rest, moved rigidly by 100 mm (depths do not change);
     // frame 1: the first sphere 3 mm further into the second.
     Eigen::MatrixX3d frame = muscle.rest.V;
@@ -95,9 +95,9 @@ TEST(MusclePenetrationTest, AWrappedTrialGetsTheMetricPerMuscleFrame) {
 }
 
 TEST(MusclePenetrationTest, MismatchedInputIsAnError) {
-  const mesh::IndexedMesh a = sphere_at({0, 0, 0});
+  const mesh::IndexedMesh a = penetration_sphere_at({0, 0, 0});
   EXPECT_THROW(MuscleSurfaces({a.V, a.V}, {&a.F}, 1), InvalidInputError);
-  const MuscleSurfaces two = surfaces_of(a, sphere_at({15, 0, 0}));
+  const MuscleSurfaces two = surfaces_of(a, penetration_sphere_at({15, 0, 0}));
   EXPECT_THROW((void)shared_muscle_contacts({a.V}, two, {}, 1), InvalidInputError);
   MuscleContactOptions bad;
   bad.share = 1.5;
@@ -109,8 +109,8 @@ TEST(MusclePenetrationTest, MismatchedInputIsAnError) {
 TEST(MuscleContactsTest, TwoOverlappingMusclesAreToMeetOnThePlaneBetweenThem) {
   // Spheres at x = 0 and x = 15 (radius 10) overlap between x = 5 and 10;
   // with equal shares both are to end on the plane x = 7.5.
-  const mesh::IndexedMesh a = sphere_at({0, 0, 0});
-  const mesh::IndexedMesh b = sphere_at({15, 0, 0});
+  const mesh::IndexedMesh a = penetration_sphere_at({0, 0, 0});
+  const mesh::IndexedMesh b = penetration_sphere_at({15, 0, 0});
   const MuscleSurfaces now = surfaces_of(a, b);
   const std::vector<std::vector<Contact>> contacts = shared_muscle_contacts({a.V, b.V}, now, {}, 2);
   ASSERT_EQ(contacts.size(), 2U);
@@ -151,7 +151,7 @@ TEST(MuscleContactsTest, TwoOverlappingMusclesAreToMeetOnThePlaneBetweenThem) {
       shared_muscle_contacts({a.V, b.V}, now, all, 1);
   EXPECT_NEAR(target_of(one_sided[0], a_tip).x(), 5.0, resolution);
   // Apart, nothing.
-  const mesh::IndexedMesh far = sphere_at({25, 0, 0});
+  const mesh::IndexedMesh far = penetration_sphere_at({25, 0, 0});
   const std::vector<std::vector<Contact>> apart =
       shared_muscle_contacts({a.V, far.V}, surfaces_of(a, far), {}, 1);
   EXPECT_TRUE(apart[0].empty());
@@ -162,7 +162,7 @@ TEST(MuscleContactsTest, TheLongestMoveIsTheDeepestEntryWhenTheEnteringSideTakes
   // Sphere A's tip (x near 10) lies about 2 mm inside the block B (x >= 8);
   // with all of the overlap to A, B's corners stay and A's tip moves out to
   // the block's face x = 8.
-  const mesh::IndexedMesh a = sphere_at({0, 0, 0});
+  const mesh::IndexedMesh a = penetration_sphere_at({0, 0, 0});
   const mesh::IndexedMesh b = mesh::make_box({8.0, -20.0, -20.0}, {28.0, 20.0, 20.0});
   const MuscleSurfaces now = surfaces_of(a, b);
   MuscleContactOptions all;
@@ -202,10 +202,10 @@ TEST(MuscleContactsTest, PinsKeepEachVertexsLatestContact) {
 }
 
 TEST(MuscleContactsTest, NewEntriesAreTheSameWithTheClearanceShortcut) {
-  const mesh::IndexedMesh a = sphere_at({0, 0, 0});
+  const mesh::IndexedMesh a = penetration_sphere_at({0, 0, 0});
   // 2.6 mm apart, their boxes overlapping.
   const Eigen::Vector3d b_centre(16, 16, 0);
-  const mesh::IndexedMesh b = sphere_at(b_centre);
+  const mesh::IndexedMesh b = penetration_sphere_at(b_centre);
   const MuscleSurfaces found_on = surfaces_of(a, b);
   std::vector<MuscleClearance> clearances;
   const std::vector<std::vector<Contact>> none =
@@ -217,7 +217,7 @@ TEST(MuscleContactsTest, NewEntriesAreTheSameWithTheClearanceShortcut) {
   const Eigen::VectorXd& clearance = clearances[0].clearance.at(1);
   EXPECT_GT(clearance.minCoeff(), 0.0);
   for (Eigen::Index v = 0; v < a.V.rows(); ++v) {
-    const double distance = (a.V.row(v).transpose() - b_centre).norm() - kRadius;
+    const double distance = (a.V.row(v).transpose() - b_centre).norm() - kPenetrationSphereRadius;
     EXPECT_LE(clearance[v], distance + 0.1) << "vertex " << v;  // facets within 0.1 mm
   }
   // A's half facing B then grows by 40 % (a solve could do this): its front enters B.
@@ -236,7 +236,7 @@ TEST(MuscleContactsTest, NewEntriesAreTheSameWithTheClearanceShortcut) {
     EXPECT_EQ(full[i].vertex, pruned[i].vertex);
     EXPECT_EQ(full[i].target, pruned[i].target);
     // Pinned onto B's surface: 10 mm from its centre.
-    EXPECT_NEAR((full[i].target - b_centre).norm(), kRadius, 0.05);
+    EXPECT_NEAR((full[i].target - b_centre).norm(), kPenetrationSphereRadius, 0.05);
   }
   // Active vertices are left alone.
   std::vector<char> active = none_active;

@@ -14,7 +14,7 @@
 namespace mmm::wrapping {
 namespace {
 
-mesh::IndexedMesh sphere_at(const Eigen::Vector3d& centre, double radius = 10.0) {
+mesh::IndexedMesh separation_sphere_at(const Eigen::Vector3d& centre, double radius = 10.0) {
   mesh::IndexedMesh sphere = mesh::make_icosphere(3, radius);
   sphere.V.rowwise() += centre.transpose();
   return sphere;
@@ -36,8 +36,9 @@ double deepest(const MuscleSeparation& separation, const std::vector<mesh::Index
 
 TEST(MuscleSeparationTest, TwoOverlappingSpheresEndApartWithTheirVolumes) {
   // 3 mm of overlap between the first two; the third is far from both.
-  const std::vector<mesh::IndexedMesh> surfaces = {sphere_at({0, 0, 0}), sphere_at({17, 0, 0}),
-                                                   sphere_at({0, 60, 0})};
+  const std::vector<mesh::IndexedMesh> surfaces = {separation_sphere_at({0, 0, 0}),
+                                                   separation_sphere_at({17, 0, 0}),
+                                                   separation_sphere_at({0, 60, 0})};
   const MuscleSeparation separation = separate_muscles(surfaces, {}, {}, 2);
   ASSERT_EQ(separation.positions.size(), 3U);
   EXPECT_NEAR(separation.overlap_before_mm[0], 3.0, 0.2);
@@ -62,8 +63,9 @@ TEST(MuscleSeparationTest, TwoOverlappingSpheresEndApartWithTheirVolumes) {
 TEST(MuscleSeparationTest, AMusclePressedOnABoneLetsTheOtherTakeTheOverlap) {
   // The second sphere sits on a bone (a big sphere behind it): it cannot give
   // way, so the first takes the overlap, and the second stays out of the bone.
-  const std::vector<mesh::IndexedMesh> surfaces = {sphere_at({0, 0, 0}), sphere_at({17, 0, 0})};
-  const mesh::IndexedMesh bone_mesh = sphere_at({57.05, 0, 0}, 30.0);
+  const std::vector<mesh::IndexedMesh> surfaces = {separation_sphere_at({0, 0, 0}),
+                                                   separation_sphere_at({17, 0, 0})};
+  const mesh::IndexedMesh bone_mesh = separation_sphere_at({57.05, 0, 0}, 30.0);
   const std::vector<PosableBone> bones = {
       {"bone", std::make_shared<const mesh::SignedDistance>(bone_mesh)}};
   const MuscleSeparation separation = separate_muscles(surfaces, bones, {}, 2);
@@ -80,7 +82,8 @@ TEST(MuscleSeparationTest, AMusclePressedOnABoneLetsTheOtherTakeTheOverlap) {
 TEST(MuscleSeparationTest, BadOptionsAreRefused) {
   SeparationOptions options;
   options.max_rounds = 0;
-  EXPECT_THROW((void)separate_muscles({sphere_at({0, 0, 0})}, {}, options, 1), InvalidInputError);
+  EXPECT_THROW((void)separate_muscles({separation_sphere_at({0, 0, 0})}, {}, options, 1),
+               InvalidInputError);
 }
 
 }  // namespace

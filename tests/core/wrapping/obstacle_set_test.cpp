@@ -10,17 +10,14 @@
 #include <numbers>
 
 #include "core/errors.h"
+#include "tests/support/test_helpers.h"
 
 namespace mmm::wrapping {
 namespace {
 
 using Eigen::Vector3d;
 
-double polyline_length(const std::vector<Vector3d>& points) {
-  double length = 0;
-  for (std::size_t i = 1; i < points.size(); ++i) length += (points[i] - points[i - 1]).norm();
-  return length;
-}
+using test::polyline_length;
 
 // Great-circle wrap on the near side, from the geometry alone: the angle
 // between P and S seen from the centre, less the two tangent angles.
@@ -31,7 +28,8 @@ double sphere_geodesic(const Vector3d& p, const Vector3d& s, double r, bool long
   return std::sqrt(p.squaredNorm() - r * r) + std::sqrt(s.squaredNorm() - r * r) + r * theta;
 }
 
-Obstacle sphere_at(const Vector3d& centre, double radius, const std::string& quadrant = "all") {
+Obstacle sphere_obstacle_at(const Vector3d& centre, double radius,
+                            const std::string& quadrant = "all") {
   Obstacle obstacle;
   obstacle.shape = ObstacleShape::kSphere;
   obstacle.pose.translation() = centre;
@@ -43,7 +41,7 @@ Obstacle sphere_at(const Vector3d& centre, double radius, const std::string& qua
 
 TEST(ObstacleSetTest, SphereWrapIsTheGreatCircleGeodesic) {
   const Vector3d c(10, 20, 30);
-  const Obstacle sphere = sphere_at(c, 40.0);
+  const Obstacle sphere = sphere_obstacle_at(c, 40.0);
   const Vector3d p = c + Vector3d(-80, -20, 10);
   const Vector3d s = c + Vector3d(90, -25, -5);
   WrapOptions fine;
@@ -65,7 +63,7 @@ TEST(ObstacleSetTest, SphereWrapIsTheGreatCircleGeodesic) {
 }
 
 TEST(ObstacleSetTest, AQuadrantSendsTheSphereWrapTheLongWayRound) {
-  Obstacle sphere = sphere_at(Vector3d::Zero(), 40.0);
+  Obstacle sphere = sphere_obstacle_at(Vector3d::Zero(), 40.0);
   sphere.pose.linear().setIdentity();
   const Vector3d p(-80, -20, 0);
   const Vector3d s(90, -25, 0);
@@ -81,7 +79,7 @@ TEST(ObstacleSetTest, AQuadrantSendsTheSphereWrapTheLongWayRound) {
 }
 
 TEST(ObstacleSetTest, ASegmentThatMissesStaysStraightAndInsidePointsAreFlagged) {
-  const Obstacle sphere = sphere_at(Vector3d::Zero(), 10.0);
+  const Obstacle sphere = sphere_obstacle_at(Vector3d::Zero(), 10.0);
   const WrapResult miss = wrap_segment(Vector3d(-50, 30, 0), Vector3d(50, 30, 0), sphere);
   EXPECT_FALSE(miss.wrapped);
   EXPECT_DOUBLE_EQ(miss.length, 100.0);
@@ -132,7 +130,7 @@ TEST(ObstacleSetTest, CylinderWrapIsAHelixTheUnrolledStraightLine) {
 }
 
 TEST(ObstacleSetTest, BadObstaclesAreErrors) {
-  Obstacle obstacle = sphere_at(Vector3d::Zero(), 0.0);
+  Obstacle obstacle = sphere_obstacle_at(Vector3d::Zero(), 0.0);
   EXPECT_THROW(wrap_segment(Vector3d(-50, 0, 0), Vector3d(50, 0, 0), obstacle), InvalidInputError);
   obstacle.radius = 10;
   obstacle.quadrant = "+q";

@@ -21,9 +21,9 @@ namespace {
 using Eigen::MatrixX3d;
 using Eigen::Vector3d;
 
-constexpr double kRadius = 20.0;
+constexpr double kDeformerSphereRadius = 20.0;
 
-mesh::IndexedMesh sphere() { return mesh::make_icosphere(4, kRadius); }
+mesh::IndexedMesh sphere() { return mesh::make_icosphere(4, kDeformerSphereRadius); }
 
 TEST(VolumeDeformerTest, TheRestTargetsGiveTheRestSurface) {
   const mesh::IndexedMesh rest = sphere();
@@ -57,7 +57,7 @@ TEST(VolumeDeformerTest, AnInflatingSkeletonKeepsTheVolumeAndTheSphere) {
   EXPECT_LT(std::abs(result.volume_error), 1e-9);
   EXPECT_GE(result.volume_iterations, 1);
   const Eigen::VectorXd radii = result.x.rowwise().norm();
-  EXPECT_LT((radii.array() - kRadius).abs().maxCoeff(), 0.01 * kRadius);
+  EXPECT_LT((radii.array() - kDeformerSphereRadius).abs().maxCoeff(), 0.01 * kDeformerSphereRadius);
 }
 
 TEST(VolumeDeformerTest, AStretchedSkeletonThinsTheSurfaceAtConstantVolume) {
@@ -73,8 +73,8 @@ TEST(VolumeDeformerTest, AStretchedSkeletonThinsTheSurfaceAtConstantVolume) {
   EXPECT_LT(std::abs(result.volume_error), 1e-9);
   const double height = result.x.col(2).maxCoeff() - result.x.col(2).minCoeff();
   const double width = result.x.col(0).maxCoeff() - result.x.col(0).minCoeff();
-  EXPECT_GT(height, 2.2 * kRadius);
-  EXPECT_LT(width, 2.0 * kRadius * 0.97);
+  EXPECT_GT(height, 2.2 * kDeformerSphereRadius);
+  EXPECT_LT(width, 2.0 * kDeformerSphereRadius * 0.97);
   // The volume of an ellipsoid with these extents is close to the rest volume.
   const double ellipsoid = 4.0 / 3.0 * std::numbers::pi * (width / 2) * (width / 2) * (height / 2);
   EXPECT_NEAR(ellipsoid / deformer.rest_volume(), 1.0, 0.05);
@@ -113,7 +113,8 @@ TEST(VolumeDeformerTest, AMuscleForcedIntoABoneComesOutOfItWithItsVolume) {
   // z = -8): contacts push the entered cap out, the volume moves up.
   const mesh::IndexedMesh rest = sphere();
   const VolumeDeformer deformer(rest);
-  const MatrixX3d targets = rest.V.rowwise() + Eigen::RowVector3d(0, 0, kRadius - 8.0);
+  const MatrixX3d targets =
+      rest.V.rowwise() + Eigen::RowVector3d(0, 0, kDeformerSphereRadius - 8.0);
   ASSERT_LT(targets.col(2).minCoeff(), -7.9);
   const DeformResult result = deformer.solve(targets, {}, {}, half_space_contacts);
   EXPECT_TRUE(result.converged);
@@ -123,7 +124,7 @@ TEST(VolumeDeformerTest, AMuscleForcedIntoABoneComesOutOfItWithItsVolume) {
   EXPECT_LT(std::abs(result.volume_error), 1e-9);
   // The displaced volume went sideways and up: wider and taller than the sphere.
   const double width = result.x.col(0).maxCoeff() - result.x.col(0).minCoeff();
-  EXPECT_GT(width, 2.0 * kRadius + 1.0);
+  EXPECT_GT(width, 2.0 * kDeformerSphereRadius + 1.0);
   EXPECT_GT(result.x.col(2).maxCoeff(), targets.col(2).maxCoeff());
   std::printf("contacts %zu rounds %d iterations %d width %.2f top +%.2f\n", result.contacts.size(),
               result.contact_rounds, result.volume_iterations, width,

@@ -72,7 +72,7 @@ TEST(PvdTest, AttributesAreXmlEscaped) {
 }
 
 // Each bad entry names the entry and leaves no file behind.
-void expect_invalid(const PvdEntry& entry, const std::string& message) {
+void expect_invalid_entry(const PvdEntry& entry, const std::string& message) {
   test::ScratchDir scratch("pvd");
   std::vector<PvdEntry> entries = two_parts_two_steps();
   entries.push_back(entry);
@@ -82,23 +82,25 @@ void expect_invalid(const PvdEntry& entry, const std::string& message) {
 }
 
 TEST(PvdTest, AbsoluteFilePathIsInvalidInput) {
-  expect_invalid({1.0, std::filesystem::temp_directory_path() / "femur.vtp", 0, ""},
-                 "entry 4 file '");
-  expect_invalid({1.0, "/femur.vtp", 0, ""}, "is absolute; give it relative to the .pvd's folder");
+  expect_invalid_entry({1.0, std::filesystem::temp_directory_path() / "femur.vtp", 0, ""},
+                       "entry 4 file '");
+  expect_invalid_entry({1.0, "/femur.vtp", 0, ""},
+                       "is absolute; give it relative to the .pvd's folder");
 }
 
 TEST(PvdTest, FileOutsideTheFolderIsInvalidInput) {
-  expect_invalid({1.0, "../femur.vtp", 0, ""}, "entry 4 file '../femur.vtp' does not name a file");
-  expect_invalid({1.0, "walk/../../femur.vtp", 0, ""}, "does not name a file inside");
-  expect_invalid({1.0, "", 0, ""}, "entry 4 has an empty file path");
+  expect_invalid_entry({1.0, "../femur.vtp", 0, ""},
+                       "entry 4 file '../femur.vtp' does not name a file");
+  expect_invalid_entry({1.0, "walk/../../femur.vtp", 0, ""}, "does not name a file inside");
+  expect_invalid_entry({1.0, "", 0, ""}, "entry 4 has an empty file path");
 }
 
 TEST(PvdTest, NonFiniteTimeAndNegativePartAreInvalidInput) {
-  expect_invalid({std::numeric_limits<double>::quiet_NaN(), "a.vtp", 0, ""},
-                 "entry 4 has a non-finite time");
-  expect_invalid({std::numeric_limits<double>::infinity(), "a.vtp", 0, ""},
-                 "entry 4 has a non-finite time");
-  expect_invalid({1.0, "a.vtp", -1, ""}, "entry 4 has part -1");
+  expect_invalid_entry({std::numeric_limits<double>::quiet_NaN(), "a.vtp", 0, ""},
+                       "entry 4 has a non-finite time");
+  expect_invalid_entry({std::numeric_limits<double>::infinity(), "a.vtp", 0, ""},
+                       "entry 4 has a non-finite time");
+  expect_invalid_entry({1.0, "a.vtp", -1, ""}, "entry 4 has part -1");
 }
 
 TEST(PvdTest, HandWrittenCollectionWithDefaultsIsRead) {

@@ -109,8 +109,8 @@ TEST(VtpPolylinesTest, ArraysAppearAsPointAndCellData) {
 }
 
 // Each bad input names what is wrong and leaves no file behind.
-void expect_invalid(const Polylines& polylines, const VtpArrays& arrays,
-                    const std::string& message) {
+void expect_invalid_polylines(const Polylines& polylines, const VtpArrays& arrays,
+                              const std::string& message) {
   test::ScratchDir scratch("vtp-polylines");
   EXPECT_THAT([&] { write_vtp_polylines(polylines, scratch / "bad.vtp", arrays); },
               ThrowsMessage<InvalidInputError>(HasSubstr(message)));
@@ -120,41 +120,43 @@ void expect_invalid(const Polylines& polylines, const VtpArrays& arrays,
 TEST(VtpPolylinesTest, LineOfOnePointIsInvalidInput) {
   Polylines fibres = make_fibres();
   fibres.lines[1] = {3};
-  expect_invalid(fibres, {}, "line 1 has 1 point(s); a polyline needs at least 2");
+  expect_invalid_polylines(fibres, {}, "line 1 has 1 point(s); a polyline needs at least 2");
 }
 
 TEST(VtpPolylinesTest, IndexOutOfRangeIsInvalidInput) {
   Polylines fibres = make_fibres();
   fibres.lines[2].push_back(8);
-  expect_invalid(fibres, {}, "line 2 refers to point 8 but there are 8 points");
+  expect_invalid_polylines(fibres, {}, "line 2 refers to point 8 but there are 8 points");
   fibres.lines[2].back() = -1;
-  expect_invalid(fibres, {}, "line 2 refers to point -1");
+  expect_invalid_polylines(fibres, {}, "line 2 refers to point -1");
 }
 
 TEST(VtpPolylinesTest, NonFiniteCoordinateIsInvalidInput) {
   Polylines fibres = make_fibres();
   fibres.points(5, 1) = std::numeric_limits<double>::quiet_NaN();
-  expect_invalid(fibres, {}, "point 5 has a non-finite coordinate");
+  expect_invalid_polylines(fibres, {}, "point 5 has a non-finite coordinate");
 }
 
 TEST(VtpPolylinesTest, NoLinesIsInvalidInput) {
   Polylines fibres = make_fibres();
   fibres.lines.clear();
-  expect_invalid(fibres, {}, "there are no polylines");
+  expect_invalid_polylines(fibres, {}, "there are no polylines");
 }
 
 TEST(VtpPolylinesTest, ArrayLengthMismatchIsInvalidInput) {
   const Polylines fibres = make_fibres();
   VtpArrays per_point;
   per_point.point_scalars.emplace_back("strain", Eigen::VectorXd::Ones(3));
-  expect_invalid(fibres, per_point,
-                 "point array 'strain' has 3 values but the polylines have 8 points (one value "
-                 "per point)");
+  expect_invalid_polylines(
+      fibres, per_point,
+      "point array 'strain' has 3 values but the polylines have 8 points (one value "
+      "per point)");
   VtpArrays per_line;
   per_line.cell_scalars.emplace_back("force", Eigen::VectorXd::Ones(8));
-  expect_invalid(fibres, per_line,
-                 "cell array 'force' has 8 values but the polylines have 3 lines (one value "
-                 "per line)");
+  expect_invalid_polylines(
+      fibres, per_line,
+      "cell array 'force' has 8 values but the polylines have 3 lines (one value "
+      "per line)");
 }
 
 std::string two_piece_lines_vtp(const std::string& second_offsets) {
