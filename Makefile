@@ -20,11 +20,13 @@ APT_PACKAGES := build-essential cmake ninja-build pkg-config python3 \
 # The browser test of the operator web UI (tests/web): headless Chromium and
 # npm for playwright-core (nodejs itself may come from Debian or NodeSource).
 WEB_TEST_PACKAGES := chromium
-# Extra tools used by .ci/run (format and static analysis).
+# Extra tools used by .ci/run (format and static analysis; clang and its
+# sanitizer runtimes compile the sanitizer builds).
 LINT_PACKAGES := clang-format clang-tidy
+SANITIZER_PACKAGES := clang libclang-rt-14-dev
 
 
-.PHONY: demo test build build-mmm deps deps-lint configure bench format lint clean
+.PHONY: demo test build build-mmm deps deps-lint deps-sanitize configure bench format lint clean
 
 # The default study end to end (cmake/demo.sh): the default atlas (built when
 # missing or when its recipe changed), synthetic patient 1 with its calibrated
@@ -65,6 +67,9 @@ deps:
 
 deps-lint:
 	@./cmake/install_apt_packages.sh $(LINT_PACKAGES)
+
+deps-sanitize:
+	@./cmake/install_apt_packages.sh $(SANITIZER_PACKAGES)
 
 bench: build
 	./bench/run $(SUITE)

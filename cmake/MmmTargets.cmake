@@ -18,7 +18,10 @@ function(mmm_target_settings target)
     # inlined third-party code (OpenMesh's PropertyT::push_back(T()) with an
     # intentionally uninitialised VectorT); the plain build keeps the warning.
     target_compile_options(${target} PRIVATE -fsanitize=${MMM_SANITIZE} -fno-omit-frame-pointer
-                                             -fno-sanitize-recover=all -Wno-maybe-uninitialized)
+                                             -fno-sanitize-recover=all)
+    if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+      target_compile_options(${target} PRIVATE -Wno-maybe-uninitialized)
+    endif()
     target_link_options(${target} PRIVATE -fsanitize=${MMM_SANITIZE})
   endif()
 endfunction()
