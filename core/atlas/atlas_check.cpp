@@ -98,7 +98,14 @@ double inside_fraction(const std::vector<Eigen::Vector3d>& polyline, double step
   for (std::size_t i = 1; i < polyline.size(); ++i) {
     const Eigen::Vector3d& a = polyline[i - 1];
     const Eigen::Vector3d& b = polyline[i];
-    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step_mm)));
+    // Bounded, and defined for any segment: a non-finite or absurdly long one
+    // (a corrupt action line) is sampled kMaxSegmentSamples times, not cast
+    // out of int's range.
+    constexpr double kMaxSegmentSamples = 1e5;
+    const double wanted = std::ceil((b - a).norm() / step_mm);
+    const int steps = std::isfinite(wanted)
+                          ? static_cast<int>(std::clamp(wanted, 1.0, kMaxSegmentSamples))
+                          : static_cast<int>(kMaxSegmentSamples);
     for (int k = 1; k <= steps; ++k) sample(a + (b - a) * (static_cast<double>(k) / steps));
   }
   return static_cast<double>(inside_samples) / samples;
