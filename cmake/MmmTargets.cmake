@@ -22,13 +22,18 @@ function(mmm_target_settings target)
     if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
       target_compile_options(${target} PRIVATE -Wno-maybe-uninitialized)
     endif()
+    # The standard library's own checks (bounds of vector/string/array
+    # indexing, front() of an empty container, ...): they cover OpenMesh's
+    # property arrays too, whose own assert() checks are off in every build
+    # (core/mesh/openmesh_begin.h). ABI-compatible with the plain libraries.
+    target_compile_definitions(${target} PRIVATE _GLIBCXX_ASSERTIONS)
     target_link_options(${target} PRIVATE -fsanitize=${MMM_SANITIZE})
   endif()
 endfunction()
 
-# mmm_batched_sources(<out_var> <target> <sources>...): with MMM_UNITY, the
-# .cpp files of one folder are compiled together in batches of at most
-# MMM_UNITY_BATCH_SIZE (balanced), so that the headers are parsed and the
+# mmm_batched_sources(<out_var> <target> <batch_size> <sources>...): with
+# MMM_UNITY, the .cpp files of one folder are compiled together in batches of
+# at most <batch_size> (balanced), so that the headers are parsed and the
 # templates instantiated once per batch instead of once per file. A batch is a
 # file in the build folder that includes its sources by their path from the
 # repository root (the same text in every clone, so the compiler cache hits
@@ -36,7 +41,7 @@ endfunction()
 # span folders, so a new file reshuffles the batches of its own folder only.
 # Helpers in anonymous namespaces must therefore have names unique within
 # their folder. A folder's lone file, and any non-.cpp source, stays as it is.
-function(mmm_batched_sources out_var target)
+function(mmm_batched_sources out_var target batch_size)
   set(sources ${ARGN})
   if(NOT MMM_UNITY)
     set(${out_var} ${sources} PARENT_SCOPE)
@@ -64,7 +69,7 @@ function(mmm_batched_sources out_var target)
       list(APPEND result ${PROJECT_SOURCE_DIR}/${files})
       continue()
     endif()
-    math(EXPR batches "(${count} + ${MMM_UNITY_BATCH_SIZE} - 1) / ${MMM_UNITY_BATCH_SIZE}")
+    math(EXPR batches "(${count} + ${batch_size} - 1) / ${batch_size}")
     math(EXPR last_batch "${batches} - 1")
     foreach(batch RANGE ${last_batch})
       # Balanced: file i goes to batch floor(i * batches / count).
@@ -109,7 +114,7 @@ function(mmm_add_library name)
     add_library(${ARG_ALIAS} ALIAS ${name})
     return()
   endif()
-  mmm_batched_sources(sources ${name} ${sources})
+  mmm_batched_sources(sources ${name} ${MMM_UNITY_BATCH_SIZE} ${sources})
   add_library(${name} STATIC ${sources})
   target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
   target_link_libraries(${name} PUBLIC ${ARG_DEPS})

@@ -13,14 +13,19 @@
 
 #include "core/mesh/decimate.h"
 
-#include <OpenMesh/Tools/Decimater/DecimaterT.hh>
-#include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
-#include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "core/errors.h"
+
+// clang-format off
+#include "core/mesh/openmesh_begin.h"
+#include <OpenMesh/Tools/Decimater/DecimaterT.hh>
+#include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
+#include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
+#include "core/mesh/openmesh_end.h"
+// clang-format on
 
 namespace mmm::mesh {
 namespace {

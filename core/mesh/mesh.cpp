@@ -4,7 +4,11 @@
 #include <string>
 #include <vector>
 
+// clang-format off
+#include "core/mesh/openmesh_begin.h"
 #include <OpenMesh/Core/System/omstream.hh>
+#include "core/mesh/openmesh_end.h"
+// clang-format on
 
 #include "core/errors.h"
 

@@ -8,8 +8,13 @@
 // decimation, hulls, remeshing.
 
 #include <Eigen/Core>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <cstddef>
+
+// clang-format off
+#include "core/mesh/openmesh_begin.h"
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include "core/mesh/openmesh_end.h"
+// clang-format on
 
 namespace mmm::mesh {
 
