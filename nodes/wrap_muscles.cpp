@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/atlas/atlas_io.h"
+#include "core/bounded_json.h"
 #include "core/directory_bundle.h"
 #include "core/errors.h"
 #include "core/mesh/io/mesh_io.h"
@@ -351,7 +352,7 @@ void WrapMuscles::run(workflow::NodeContext& context) {
   const std::string motion_text(motion_bytes.begin(), motion_bytes.end());
   nlohmann::json motion_json;
   try {
-    motion_json = nlohmann::json::parse(motion_text);
+    motion_json = parse_json(motion_text);
   } catch (const nlohmann::json::exception& e) {
     throw InvalidInputError("wrap_muscles: input 'motion' is not JSON (" + std::string(e.what()) +
                             "); hint: connect fuse_motion's 'motion' output");

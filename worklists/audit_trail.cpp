@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/file_bytes.h"
 #include "workflow/host_and_time.h"
@@ -139,7 +140,7 @@ AuditRow row_of(const Statement& select) {
 nlohmann::json parse_column(const Database& database, const AuditRow& row, const std::string& text,
                             std::string_view column) {
   try {
-    return nlohmann::json::parse(text);
+    return parse_json(text);
   } catch (const nlohmann::json::exception& error) {
     throw IoError(database.path(), "audit entry seq " + std::to_string(row.seq) + ": column '" +
                                        std::string(column) + "' is not JSON (" + error.what() +
@@ -298,6 +299,15 @@ AuditHead audit_database_head(Database& database) {
   return {last.column_int64(0), last.column_text(1)};
 }
 
+std::optional<std::string> last_operator_of(Database& database, const std::string& task_id,
+                                            std::string_view action) {
+  Statement last = database.prepare(
+      "SELECT operator_name FROM audit WHERE task_id = ? AND action = ? ORDER BY seq DESC LIMIT 1");
+  last.bind_text(1, task_id).bind_text(2, action);
+  if (!last.step()) return std::nullopt;
+  return last.column_text(0);
+}
+
 std::optional<AuditHead> read_audit_meta_head(Database& database) {
   Statement read = database.prepare("SELECT value FROM meta WHERE key = 'audit_head'");
   if (!read.step()) return std::nullopt;
@@ -305,7 +315,7 @@ std::optional<AuditHead> read_audit_meta_head(Database& database) {
   AuditHead head;
   std::string problem;
   try {
-    problem = parse_head(nlohmann::json::parse(text), head);
+    problem = parse_head(parse_json(text), head);
   } catch (const nlohmann::json::exception& error) {
     problem = std::string("not JSON (") + error.what() + ")";
   }
@@ -331,7 +341,7 @@ std::optional<AuditHead> read_audit_checkpoint(const std::filesystem::path& stud
   AuditHead head;
   std::string problem;
   try {
-    const nlohmann::json json = nlohmann::json::parse(text);
+    const nlohmann::json json = parse_json(text);
     const auto format = json.is_object() ? json.find("format") : json.end();
     if (!json.is_object() || format == json.end() || *format != kCheckpointFormat) {
       problem = std::string("'format' is not '") + kCheckpointFormat + "'";

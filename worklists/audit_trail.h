@@ -136,6 +136,12 @@ void insert_audit_row(Database& database, const AuditRow& row);
 // Seq and hash of the last row.
 AuditHead audit_database_head(Database& database);
 
+// The operator of the latest entry with this action for this task, or
+// std::nullopt when there is none (who submitted the values a reviewer
+// looks at, whoever the task is assigned to now).
+std::optional<std::string> last_operator_of(Database& database, const std::string& task_id,
+                                            std::string_view action);
+
 // meta 'audit_head'; std::nullopt when absent. Throws IoError naming the
 // database when the value is not {"seq": n, "hash": "<64 hex>"}.
 std::optional<AuditHead> read_audit_meta_head(Database& database);

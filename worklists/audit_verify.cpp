@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "core/errors.h"
+#include "worklists/audit_cross_check.h"
 #include "worklists/audit_trail.h"
 
 namespace mmm::worklists {
@@ -393,6 +394,12 @@ std::string_view audit_problem_kind_name(AuditProblemKind kind) {
       return "checkpoint_behind";
     case AuditProblemKind::kMetaMismatch:
       return "meta_mismatch";
+    case AuditProblemKind::kTaskUnaudited:
+      return "task_unaudited";
+    case AuditProblemKind::kValueMismatch:
+      return "value_mismatch";
+    case AuditProblemKind::kArtifactChanged:
+      return "artifact_changed";
   }
   return "unknown";
 }
@@ -407,7 +414,13 @@ AuditVerification verify_audit(workflow::Database& database,
   ReadHead checkpoint = read_head([&study_dir] { return read_audit_checkpoint(study_dir); });
   const ReadSnapshot snapshot(database);
   ReadHead meta = read_head([&database] { return read_audit_meta_head(database); });
-  return Verifier(read_audit_rows(database), std::move(meta), std::move(checkpoint)).run();
+  AuditVerification verification =
+      Verifier(read_audit_rows(database), std::move(meta), std::move(checkpoint)).run();
+  for (AuditProblem& problem : cross_check_tasks(database, study_dir)) {
+    verification.problems.push_back(std::move(problem));
+    verification.intact = false;
+  }
+  return verification;
 }
 
 }  // namespace mmm::worklists

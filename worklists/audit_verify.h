@@ -32,6 +32,10 @@
 //                              rewritten consistently (the only trace of that);
 //   behind, chain intact       kCheckpointBehind: a crash between commit and
 //                              checkpoint write. A warning: intact stays true.
+//
+// Then the tasks table and the accepted results are checked against the
+// chain (audit_cross_check.h): a chain that is intact but no longer describes
+// the study's tasks and results is not "intact".
 
 #include <cstdint>
 #include <filesystem>
@@ -54,6 +58,10 @@ enum class AuditProblemKind {
   kCheckpointMismatch,  // seq: the checkpoint's seq
   kCheckpointBehind,    // seq: the first entry after the checkpoint (warning only)
   kMetaMismatch,        // seq: the last entry's seq (what meta should name)
+  // Cross-checks of the tasks against the trail (audit_cross_check.h):
+  kTaskUnaudited,    // seq: 0; a task no entry opened
+  kValueMismatch,    // seq: the last accept/correct entry of the task (0: none)
+  kArtifactChanged,  // seq: as kValueMismatch; a result artifact edited in place
 };
 
 // "edited", "deleted", ..., "checkpoint_behind", "meta_mismatch".

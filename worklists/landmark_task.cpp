@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/image/radiograph_pair.h"
 #include "core/landmarks/landmark_set.h"
@@ -193,7 +194,7 @@ Json landmark_task_request(const workflow::CacheKeyParts& parts,
   request["patient"] = "";
   if (const auto patient = parts.input_hashes.find("patient");
       patient != parts.input_hashes.end()) {
-    const Json value = Json::parse(artifacts.get(patient->second), nullptr, false);
+    const Json value = parse_json_or_discarded(artifacts.get(patient->second));
     if (value.is_string()) request["patient"] = value.get<std::string>();
   }
   Json landmarks = Json::array();

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/file_bytes.h"
 #include "core/hash/sha256.h"
@@ -30,7 +31,8 @@ void write_operators(const fs::path& root, const std::vector<OperatorRecord>& op
   for (const OperatorRecord& record : operators) {
     list.push_back({{"name", record.name},
                     {"token_sha256", record.token_sha256},
-                    {"created_at", record.created_at}});
+                    {"created_at", record.created_at},
+                    {"role", record.role}});
   }
   const Json document = {{"format", kFormat}, {"version", 1}, {"operators", list}};
   fs::create_directories(operators_file(root).parent_path());
@@ -56,7 +58,7 @@ std::vector<OperatorRecord> read_operators(const fs::path& root) {
   if (!fs::exists(file, error)) return {};
   Json document;
   try {
-    document = Json::parse(read_file_bytes(file, fs::file_size(file)));
+    document = parse_json(read_file_bytes(file, fs::file_size(file)));
   } catch (const Json::parse_error& e) {
     throw IoError(file, std::string("is not valid JSON: ") + e.what() +
                             "; hint: restore it or add the operators again");
@@ -72,21 +74,30 @@ std::vector<OperatorRecord> read_operators(const fs::path& root) {
       throw IoError(file, "operators[" + std::to_string(operators.size()) +
                               "] needs a 'name' and a 'token_sha256' string");
     }
+    const std::string role = entry.value("role", kOperatorRole);
+    if (role != kOperatorRole && role != kSupervisorRole) {
+      throw IoError(file, "operators[" + std::to_string(operators.size()) + "] has role '" + role +
+                              R"('; a role is "operator" or "supervisor")");
+    }
     operators.push_back({entry["name"].get<std::string>(), entry["token_sha256"].get<std::string>(),
-                         entry.value("created_at", "")});
+                         entry.value("created_at", ""), role});
   }
   return operators;
 }
 
-std::string add_operator(const fs::path& root, const std::string& name, bool replace) {
+std::string add_operator(const fs::path& root, const std::string& name, bool replace,
+                         const std::string& role) {
   check_operator_name(name);
+  if (role != kOperatorRole && role != kSupervisorRole) {
+    throw InvalidInputError("role '" + role + "' is not known; hint: operator or supervisor");
+  }
   std::error_code error;
   if (!fs::is_directory(root, error)) {
     throw IoError(root, "is not a folder; hint: --root names the folder that holds the studies");
   }
   std::vector<OperatorRecord> operators = read_operators(root);
   std::string token = random_token();
-  const OperatorRecord record{name, hash::sha256_hex(token), workflow::utc_now()};
+  const OperatorRecord record{name, hash::sha256_hex(token), workflow::utc_now(), role};
   bool found = false;
   for (OperatorRecord& existing : operators) {
     if (existing.name != name) continue;
@@ -110,6 +121,15 @@ std::optional<std::string> operator_for_token(const fs::path& root, const std::s
     if (same_hash(record.token_sha256, digest)) found = record.name;
   }
   return found;
+}
+
+bool is_supervisor(const fs::path& root, const std::string& name) {
+  std::error_code error;
+  if (!fs::exists(operators_file(root), error)) return false;
+  for (const OperatorRecord& record : read_operators(root)) {
+    if (record.name == name) return record.role == kSupervisorRole;
+  }
+  return false;
 }
 
 void check_registered_operator(const fs::path& root, const std::string& name) {

@@ -51,6 +51,8 @@ nlohmann::json task_to_json(const Task& task) {
           {"submission", task.submission},
           {"result", task.result},
           {"rejection_reasons", task.rejection_reasons},
+          {"submitted_by", task.submitted_by},
+          {"pending_correction", task.pending_correction},
           {"revision", task.revision}};
 }
 

@@ -11,7 +11,9 @@
 // every reason); one that passes is accepted at once unless the node asks for
 // a second person's review (then it waits in 'submitted'). A later submission
 // for an accepted task is a correction: it needs a reason, supersedes the old
-// values and re-runs exactly the downstream nodes.
+// values and re-runs exactly the downstream nodes; when the node asks for
+// review, the correction waits for a second person too (the task stays
+// accepted with its old values meanwhile).
 //
 // The assignee is kept apart from the state (Camunda's lesson): a claimed
 // task has one; releasing clears it; reassigning changes it without a detour
@@ -53,8 +55,15 @@ struct Task {
   nlohmann::json submission;                   // the latest submission as given (null: none)
   nlohmann::json result;                       // the accepted values (null: none)
   std::vector<std::string> rejection_reasons;  // of the latest rejection
-  std::int64_t result_execution = 0;           // execution row of the accepted result
-  int revision = 0;                            // +1 at every change
+  // Who submitted the values that await review or were accepted (the
+  // reviewer can never be this operator, whoever the task is assigned to).
+  std::string submitted_by;
+  // A correction of accepted values that awaits review (nodes with review):
+  // {"submission", "reason", "by"}; null when none. The accepted values stay
+  // in force until a second operator accepts it.
+  nlohmann::json pending_correction;
+  std::int64_t result_execution = 0;  // execution row of the accepted result
+  int revision = 0;                   // +1 at every change
 };
 
 nlohmann::json task_to_json(const Task& task);

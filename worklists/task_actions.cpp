@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <optional>
 #include <utility>
 
@@ -119,21 +120,72 @@ void require_operator(const Task& task, const Actor& actor, const std::string& w
   if (task.assignee != actor.operator_name) {
     throw TaskError(state_text(task) + "; only its assignee can " + what +
                     " it; hint: 'mmm task claim " + task.id + "' first, or ask " +
-                    (task.assignee.empty() ? std::string("a lead") : task.assignee) +
+                    (task.assignee.empty() ? std::string("a supervisor") : task.assignee) +
                     " to release or reassign it");
   }
 }
 
+// Rule: a task someone has claimed is released, reassigned or cancelled by
+// that person or by a supervisor, nobody else.
+void require_assignee_or_supervisor(const Task& task, const Actor& actor, const std::string& what) {
+  if (task.assignee.empty() || task.assignee == actor.operator_name || actor.supervisor) return;
+  throw TaskError(state_text(task) + "; only " + task.assignee + " or a supervisor can " + what +
+                  " it (rule: assignee or supervisor); hint: ask " + task.assignee +
+                  ", or a supervisor ('mmm operator add NAME --supervisor')");
+}
+
+// Who submitted the values awaiting review: recorded with the task, or, for a
+// task submitted by an older mmm, the operator of its last "submit" entry.
+std::string submitter_of(Study& study, const Task& task) {
+  if (!task.submitted_by.empty()) return task.submitted_by;
+  return last_operator_of(study.database(), task.id, "submit").value_or(task.assignee);
+}
+
+// Rule: the reviewer of values is never the operator who submitted them.
+void require_second_operator(const std::string& submitter, const Task& task, const Actor& actor) {
+  if (submitter == actor.operator_name) {
+    throw TaskError("task " + task.id + ": these values were submitted by " + actor.operator_name +
+                    ", who cannot review them (rule: four eyes, whoever the task is assigned "
+                    "to); hint: a second operator accepts or rejects them");
+  }
+}
+
+bool is_blank(const std::string& text) {
+  return std::all_of(text.begin(), text.end(),
+                     [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; });
+}
+
+// Rule: a reason is never blank.
+void require_reason(const std::string& reason, const std::string& what) {
+  if (is_blank(reason)) {
+    throw TaskError(what +
+                    " needs a reason that says why (--reason \"...\"); a blank one is "
+                    "not a reason");
+  }
+}
+
+bool review_required(const Task& task) {
+  return task.key_parts.params.contains("review") &&
+         std::get<bool>(task.key_parts.params.at("review"));
+}
+
+// Records `evaluation` as the task's accepted values. `submitter` gave them;
+// `actor` accepts them (the submitter themselves, or the reviewer).
 SubmitOutcome accept_values(Study& study, Task& task, const Actor& actor,
                             const ManualEvaluation& evaluation, const Json& submission,
-                            bool correction, const std::string& reason) {
+                            bool correction, const std::string& submitter,
+                            const std::string& reason) {
   SubmitOutcome outcome;
   const Json before = task.result;
-  const std::string why = correction ? "correction by " + actor.operator_name + ": " + reason
-                                     : "submitted by " + task.assignee + ", accepted";
+  const std::string reviewed =
+      submitter == actor.operator_name ? "" : ", reviewed by " + actor.operator_name;
+  const std::string why = correction ? "correction by " + submitter + reviewed + ": " + reason
+                                     : "submitted by " + submitter + ", accepted" + reviewed;
   task.result_execution = record_result(study, task, actor, evaluation, why);
   task.result = evaluation.values;
   task.submission = submission;
+  task.submitted_by = submitter;
+  task.pending_correction = nullptr;
   task.state = TaskState::kAccepted;
   task.rejection_reasons.clear();
   save(study, task);
@@ -156,6 +208,16 @@ void check_operator_name(const std::string& name) {
   if (!valid) {
     throw TaskError("operator name '" + name +
                     "' is not valid; hint: 1-64 letters, digits, '.', '_', '-' or '@'");
+  }
+  std::string lower = name;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](char c) {
+    return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  });
+  if (std::find(kReservedOperatorNames.begin(), kReservedOperatorNames.end(), lower) !=
+      kReservedOperatorNames.end()) {
+    throw TaskError("operator name '" + name +
+                    "' is reserved (it would read as mmm itself in the audit trail); hint: use "
+                    "the person's own name");
   }
 }
 
@@ -235,7 +297,7 @@ Task release_task(Study& study, const std::string& id, const Actor& actor) {
     if (task.state != TaskState::kClaimed) {
       throw TaskError(state_text(task) + ", only a claimed task can be released");
     }
-    require_operator(task, actor, "release");
+    require_assignee_or_supervisor(task, actor, "release");
     task.state = TaskState::kOpen;
     task.assignee.clear();
     save(study, task);
@@ -253,6 +315,7 @@ Task reassign_task(Study& study, const std::string& id, const Actor& actor, cons
                       ", only a claimed or submitted task can be reassigned; hint: an open task "
                       "is claimed by whoever takes it");
     }
+    require_assignee_or_supervisor(task, actor, "reassign");
     const Json before = {{"assignee", task.assignee}};
     task.assignee = to;
     save(study, task);
@@ -264,11 +327,12 @@ Task reassign_task(Study& study, const std::string& id, const Actor& actor, cons
 Task cancel_task(Study& study, const std::string& id, const Actor& actor,
                  const std::string& reason) {
   check_operator_name(actor.operator_name);
-  if (reason.empty()) throw TaskError("cancelling a task needs a reason (--reason)");
+  require_reason(reason, "cancelling a task");
   return act(study, id, [&](Task& task) {
     if (task.state == TaskState::kAccepted || task.state == TaskState::kCancelled) {
       throw TaskError(state_text(task) + ", it cannot be cancelled");
     }
+    require_assignee_or_supervisor(task, actor, "cancel");
     task.state = TaskState::kCancelled;
     save(study, task);
     audit(study, actor, task, "cancel", task.submission, nullptr, reason);
@@ -281,10 +345,15 @@ SubmitOutcome submit_task(Study& study, const std::string& id, const Actor& acto
   check_operator_name(actor.operator_name);
   return act(study, id, [&](Task& task) {
     const bool correction = task.state == TaskState::kAccepted;
-    if (correction && reason.empty()) {
+    if (correction && is_blank(reason)) {
       throw TaskError("task " + task.id + " is already accepted: a correction needs a reason " +
-                      "(--reason \"...\"); it supersedes the values of " + task.assignee +
-                      " and re-runs the downstream nodes");
+                      "that says why (--reason \"...\"); it supersedes the values of " +
+                      task.submitted_by + " and re-runs the downstream nodes");
+    }
+    if (correction && !task.pending_correction.is_null()) {
+      throw TaskError("task " + task.id + " already has a correction by " +
+                      task.pending_correction.value("by", "") +
+                      " awaiting review; hint: a second operator accepts or rejects it first");
     }
     if (!correction) {
       if (task.state != TaskState::kClaimed) {
@@ -313,38 +382,50 @@ SubmitOutcome submit_task(Study& study, const std::string& id, const Actor& acto
       outcome.task = task;
       return outcome;
     }
-    if (!correction && task.key_parts.params.contains("review") &&
-        std::get<bool>(task.key_parts.params.at("review"))) {
-      task.state = TaskState::kSubmitted;
-      task.submission = submission;
+    if (review_required(task)) {
+      if (correction) {
+        // The accepted values stay in force until a second operator agrees.
+        task.pending_correction = {
+            {"submission", submission}, {"reason", reason}, {"by", actor.operator_name}};
+      } else {
+        task.state = TaskState::kSubmitted;
+        task.submission = submission;
+        task.submitted_by = actor.operator_name;
+      }
       task.rejection_reasons.clear();
       save(study, task);
       SubmitOutcome outcome;
       outcome.awaiting_review = true;
+      outcome.correction = correction;
       outcome.values = evaluation.values;
       outcome.task = task;
       return outcome;
     }
-    return accept_values(study, task, actor, evaluation, submission, correction, reason);
+    return accept_values(study, task, actor, evaluation, submission, correction,
+                         actor.operator_name, reason);
   });
 }
 
 SubmitOutcome accept_task(Study& study, const std::string& id, const Actor& actor) {
   check_operator_name(actor.operator_name);
   return act(study, id, [&](Task& task) {
-    if (task.state != TaskState::kSubmitted) {
-      throw TaskError(state_text(task) + ", only a submitted task awaits review");
+    const bool correction =
+        task.state == TaskState::kAccepted && !task.pending_correction.is_null();
+    if (task.state != TaskState::kSubmitted && !correction) {
+      throw TaskError(state_text(task) + ", only a submitted task or a correction awaits review");
     }
-    if (task.assignee == actor.operator_name) {
-      throw TaskError("task " + task.id + " was submitted by " + actor.operator_name +
-                      ": a second operator must review it");
-    }
-    const ManualEvaluation evaluation = evaluate(task, task.submission);
+    const Json submission = correction ? task.pending_correction.at("submission") : task.submission;
+    const std::string submitter =
+        correction ? task.pending_correction.value("by", "") : submitter_of(study, task);
+    require_second_operator(submitter, task, actor);
+    const ManualEvaluation evaluation = evaluate(task, submission);
     if (!evaluation.reasons.empty()) {
       throw TaskError("task " + task.id +
                       "'s submission no longer validates: " + join(evaluation.reasons));
     }
-    return accept_values(study, task, actor, evaluation, task.submission, false, "reviewed");
+    const std::string reason =
+        correction ? task.pending_correction.value("reason", "") : std::string("reviewed");
+    return accept_values(study, task, actor, evaluation, submission, correction, submitter, reason);
   });
 }
 
@@ -352,10 +433,24 @@ Task reject_task(Study& study, const std::string& id, const Actor& actor,
                  const std::vector<std::string>& reasons) {
   check_operator_name(actor.operator_name);
   if (reasons.empty()) throw TaskError("rejecting a task needs at least one reason (--reason)");
+  for (const std::string& reason : reasons) require_reason(reason, "rejecting a task");
   return act(study, id, [&](Task& task) {
-    if (task.state != TaskState::kSubmitted) {
-      throw TaskError(state_text(task) + ", only a submitted task can be rejected by a reviewer");
+    const bool correction =
+        task.state == TaskState::kAccepted && !task.pending_correction.is_null();
+    if (task.state != TaskState::kSubmitted && !correction) {
+      throw TaskError(state_text(task) +
+                      ", only a submitted task or a correction can be rejected by a reviewer");
     }
+    if (correction) {
+      require_second_operator(task.pending_correction.value("by", ""), task, actor);
+      const Json rejected = task.pending_correction.at("submission");
+      task.pending_correction = nullptr;  // the accepted values stay
+      task.rejection_reasons = reasons;
+      save(study, task);
+      audit(study, actor, task, "reject", rejected, nullptr, join(reasons));
+      return task;
+    }
+    require_second_operator(submitter_of(study, task), task, actor);
     task.state = TaskState::kOpen;
     task.assignee.clear();
     task.rejection_reasons = reasons;

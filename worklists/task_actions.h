@@ -11,8 +11,10 @@
 // A submission that fails validation is not an error: it is rejected, with
 // every reason, and the task goes back to the operator.
 
+#include <array>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/errors.h"
@@ -30,12 +32,19 @@ class TaskError : public InvalidInputError {
 struct Actor {
   std::string operator_name;  // letters, digits, '.', '_', '-', '@'; 1-64 characters
   std::string mmm_version;
+  bool supervisor = false;  // registered with the supervisor role (operators.h)
 };
 
 // The name the runner acts under when it opens or cancels tasks.
 inline constexpr const char* kSystemOperator = "mmm";
 
-// Throws TaskError unless `name` is a valid operator name.
+// Names no operator may have: the runner's own and those that would read as
+// the system's in the audit trail (compared without regard to case).
+inline constexpr std::array<std::string_view, 7> kReservedOperatorNames = {
+    "mmm", "system", "root", "admin", "administrator", "nobody", "anonymous"};
+
+// Throws TaskError unless `name` is a valid operator name that is not
+// reserved.
 void check_operator_name(const std::string& name);
 
 // Prepares the tasks and audit tables of a study (idempotent).
@@ -49,8 +58,11 @@ std::vector<Task> open_waiting_tasks(workflow::Study& study, const Actor& actor)
 
 Task claim_task(workflow::Study& study, const std::string& id, const Actor& actor);
 Task release_task(workflow::Study& study, const std::string& id, const Actor& actor);
-// Hands a claimed (or submitted) task to `to`; anyone may do it (a lead
-// redistributing work), the audit says who.
+// Release, reassign and cancel of a task that has an assignee (claimed or
+// submitted): only the assignee or a supervisor; the audit says who. An open
+// task may be cancelled by any operator. Reasons are never blank.
+// Reassigning hands the task to `to`; it never makes the submitter of the
+// values awaiting review their reviewer.
 Task reassign_task(workflow::Study& study, const std::string& id, const Actor& actor,
                    const std::string& to);
 Task cancel_task(workflow::Study& study, const std::string& id, const Actor& actor,
@@ -66,13 +78,16 @@ struct SubmitOutcome {
 };
 
 // Submits values for a task the operator has claimed, or corrects an accepted
-// task (then `reason` is required). The submission is validated by the node
-// type (landmark_task.h).
+// task (then a non-blank `reason` is required; with a review node the
+// correction awaits review and the accepted values stay in force). The
+// submission is validated by the node type (landmark_task.h).
 SubmitOutcome submit_task(workflow::Study& study, const std::string& id, const Actor& actor,
                           const nlohmann::json& submission, const std::string& reason = {});
 
 // Review (nodes with review = true): a second operator accepts or rejects a
-// submitted task; the submitter cannot review their own work.
+// submitted task or a pending correction; the submitter can never review
+// their own work, whoever the task is assigned to. Rejecting a correction
+// keeps the accepted values; rejecting a first submission reopens the task.
 SubmitOutcome accept_task(workflow::Study& study, const std::string& id, const Actor& actor);
 Task reject_task(workflow::Study& study, const std::string& id, const Actor& actor,
                  const std::vector<std::string>& reasons);

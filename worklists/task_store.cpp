@@ -14,7 +14,8 @@ using Json = nlohmann::json;
 
 constexpr const char* kTaskColumns =
     "id, node, node_type, cache_key, key_json, state, assignee, created_at, updated_at, "
-    "request_json, submission_json, result_json, rejection_json, result_execution, revision";
+    "request_json, submission_json, result_json, rejection_json, result_execution, revision, "
+    "submitted_by, pending_json";
 
 Task read_row(Statement& row) {
   Task task;
@@ -38,6 +39,8 @@ Task read_row(Statement& row) {
   task.rejection_reasons = Json::parse(row.column_text(12)).get<std::vector<std::string>>();
   task.result_execution = row.column_int64(13);
   task.revision = static_cast<int>(row.column_int64(14));
+  task.submitted_by = row.column_text(15);
+  task.pending_correction = Json::parse(row.column_text(16));
   return task;
 }
 
@@ -56,7 +59,9 @@ void bind_fields(Statement& statement, const Task& task) {
       .bind_text(12, task.result.dump())
       .bind_text(13, Json(task.rejection_reasons).dump())
       .bind_int64(14, task.result_execution)
-      .bind_int64(15, task.revision);
+      .bind_int64(15, task.revision)
+      .bind_text(16, task.submitted_by)
+      .bind_text(17, task.pending_correction.dump());
 }
 
 std::vector<Task> select_tasks(Database& database, const std::string& where,
@@ -91,6 +96,24 @@ CREATE TABLE IF NOT EXISTS tasks(
   revision INTEGER NOT NULL DEFAULT 0);
 CREATE INDEX IF NOT EXISTS tasks_by_node ON tasks(node, created_at);
 )sql");
+  // Studies created before review covered corrections: add the columns.
+  bool current = false;
+  {
+    Statement has_column =
+        database.prepare("SELECT 1 FROM pragma_table_info('tasks') WHERE name = 'submitted_by'");
+    current = has_column.step();
+  }
+  if (!current) {
+    database.exec(
+        "ALTER TABLE tasks ADD COLUMN submitted_by TEXT NOT NULL DEFAULT '';"
+        "ALTER TABLE tasks ADD COLUMN pending_json TEXT NOT NULL DEFAULT 'null';");
+  }
+}
+
+bool tasks_table_exists(Database& database) {
+  Statement table =
+      database.prepare("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'tasks'");
+  return table.step();
 }
 
 std::string new_task_id() {
@@ -106,8 +129,9 @@ void insert_task(Database& database, const Task& task) {
     throw InvalidInputError("task id " + task.id + " is already used in " +
                             database.path().string());
   }
-  Statement insert = database.prepare(std::string("INSERT INTO tasks(") + kTaskColumns +
-                                      ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  Statement insert =
+      database.prepare(std::string("INSERT INTO tasks(") + kTaskColumns +
+                       ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   insert.bind_text(1, task.id);
   bind_fields(insert, task);
   insert.step();
@@ -118,10 +142,10 @@ bool update_task(Database& database, const Task& task) {
       "UPDATE tasks SET node = ?2, node_type = ?3, cache_key = ?4, key_json = ?5, state = ?6, "
       "assignee = ?7, created_at = ?8, updated_at = ?9, request_json = ?10, "
       "submission_json = ?11, result_json = ?12, rejection_json = ?13, result_execution = ?14, "
-      "revision = ?15 WHERE id = ?1 AND revision = ?16");
+      "revision = ?15, submitted_by = ?16, pending_json = ?17 WHERE id = ?1 AND revision = ?18");
   update.bind_text(1, task.id);
   bind_fields(update, task);
-  update.bind_int64(16, task.revision - 1);
+  update.bind_int64(18, task.revision - 1);
   update.step();
   return database.changes() == 1;
 }

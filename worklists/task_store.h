@@ -17,6 +17,10 @@ namespace mmm::worklists {
 // first use).
 void prepare_task_tables(workflow::Database& database);
 
+// Whether the study has a tasks table (a study without manual nodes, or one
+// whose tasks were never prepared, has none).
+bool tasks_table_exists(workflow::Database& database);
+
 // A fresh task id: 10 lowercase hex characters from the system's random
 // source (40 bits: a clash among a million tasks has odds of about 1 in 2000,
 // and insert_task refuses a duplicate rather than overwrite).

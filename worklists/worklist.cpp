@@ -57,12 +57,6 @@ std::string patient_of(workflow::Database& database, const fs::path& dir) {
   return dir.filename().string();
 }
 
-bool has_tasks_table(workflow::Database& database) {
-  workflow::Statement select =
-      database.prepare("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'tasks'");
-  return select.step();
-}
-
 }  // namespace
 
 std::vector<fs::path> find_studies(const fs::path& root) {
@@ -81,10 +75,13 @@ std::vector<WorklistEntry> list_worklist(const fs::path& root, const WorklistFil
   const double now = now_seconds();
   for (const fs::path& dir : find_studies(root)) {
     workflow::Database database(dir / kDatabaseFile);
-    if (!has_tasks_table(database)) continue;
+    if (!tasks_table_exists(database)) continue;
     const std::string patient = patient_of(database, dir);
     for (Task& task : all_tasks(database)) {
-      const bool closed = task.state == TaskState::kAccepted || task.state == TaskState::kCancelled;
+      // An accepted task with a correction awaiting review still needs a person.
+      const bool closed =
+          (task.state == TaskState::kAccepted && task.pending_correction.is_null()) ||
+          task.state == TaskState::kCancelled;
       if (filter.state ? task.state != *filter.state : (closed && !filter.include_closed)) {
         continue;
       }

@@ -1,7 +1,9 @@
 // mmm worklist, mmm task ..., mmm audit ..., mmm operator ...: the manual
 // side of studies (worklists/).
 
+#include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "app/commands/commands.h"
+#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "mmm_git_revision.h"
 #include "workflow/study/study.h"
@@ -37,7 +40,7 @@ fs::path root_of(const std::string& option) {
 
 worklists::Actor actor_of(const fs::path& root, const std::string& name) {
   worklists::check_registered_operator(root, name);
-  return {name, MMM_VERSION};
+  return {name, MMM_VERSION, worklists::is_supervisor(root, name)};
 }
 
 void print_table(const std::vector<worklists::WorklistEntry>& entries) {
@@ -152,13 +155,23 @@ void add_point(Json& submission, const std::string& text) {
 Json read_submission(const TaskArgs& args) {
   Json submission = Json::object();
   if (!args.file.empty()) {
+    // A submission is a few landmarks: the web station's request limit.
+    constexpr std::uintmax_t kMaxSubmissionBytes = std::uintmax_t{1} << 20;
+    std::error_code size_error;
+    const std::uintmax_t size = std::filesystem::file_size(args.file, size_error);
     std::ifstream in(args.file);
-    if (!in) throw IoError(args.file, "cannot be read; hint: check the path");
+    if (size_error || !in) throw IoError(args.file, "cannot be read; hint: check the path");
+    if (size > kMaxSubmissionBytes) {
+      throw IoError(args.file, "is " + std::to_string(size) + " bytes; a submission is at most " +
+                                   std::to_string(kMaxSubmissionBytes) + " (1 MiB)");
+    }
     std::stringstream text;
     text << in.rdbuf();
-    submission = Json::parse(text.str(), nullptr, false);
-    if (submission.is_discarded()) {
-      throw IoError(args.file, "is not valid JSON; hint: {\"landmarks\": {NAME: {VIEW: [u, v]}}}");
+    try {
+      submission = parse_json(text.str());
+    } catch (const Json::parse_error& error) {
+      throw IoError(args.file, std::string("is not valid JSON (") + error.what() +
+                                   "); hint: {\"landmarks\": {NAME: {VIEW: [u, v]}}}");
     }
   }
   for (const std::string& point : args.points) add_point(submission, point);
@@ -289,8 +302,11 @@ void run_task_action(const std::string& action, const TaskArgs& args,
       return;
     }
     if (outcome.awaiting_review) {
-      std::cout << "task " << id << " submitted; it awaits review by a second operator "
-                << "('mmm task accept " << id << " --operator NAME')\n";
+      std::cout << "task " << id << (outcome.correction ? ": correction" : "")
+                << " submitted; it awaits review by a second operator "
+                << "('mmm task accept " << id << " --operator NAME')"
+                << (outcome.correction ? "; the accepted values stay in force until then" : "")
+                << '\n';
       return;
     }
     std::cout << "task " << id << (outcome.correction ? " corrected" : " accepted") << '\n';
@@ -430,13 +446,18 @@ void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registr
   auto op_root = std::make_shared<std::string>();
   auto op_name = std::make_shared<std::string>();
   auto op_replace = std::make_shared<bool>(false);
+  auto op_supervisor = std::make_shared<bool>(false);
   auto* add = operators->add_subcommand("add", "Register an operator; prints their token once");
   add->add_option("NAME", *op_name, "Operator name")->required();
   add->add_option("--root", *op_root, "Folder holding the studies (default: $MMM_ROOT, else .)");
   add->add_flag("--replace", *op_replace, "Give an existing operator a new token");
-  add->callback([op_root, op_name, op_replace] {
+  add->add_flag("--supervisor", *op_supervisor,
+                "May also release, reassign or cancel tasks other operators have claimed");
+  add->callback([op_root, op_name, op_replace, op_supervisor] {
     const fs::path root = root_of(*op_root);
-    const std::string token = worklists::add_operator(root, *op_name, *op_replace);
+    const std::string token = worklists::add_operator(
+        root, *op_name, *op_replace,
+        *op_supervisor ? worklists::kSupervisorRole : worklists::kOperatorRole);
     std::cout << token << '\n';
     std::cerr << "operator '" << *op_name << "' registered under " << root.string()
               << "; the token above is shown only once (the web UI asks for it)\n";
@@ -445,7 +466,7 @@ void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registr
   list->add_option("--root", *op_root, "Folder holding the studies (default: $MMM_ROOT, else .)");
   list->callback([op_root] {
     for (const worklists::OperatorRecord& record : worklists::read_operators(root_of(*op_root))) {
-      std::cout << record.name << "  (since " << record.created_at << ")\n";
+      std::cout << record.name << "  " << record.role << " since " << record.created_at << '\n';
     }
   });
 }

@@ -3,6 +3,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/bounded_json.h"
 #include "core/errors.h"
 
 namespace mmm::app::report {
@@ -19,7 +20,7 @@ std::optional<nlohmann::json> read_json_if_present(const std::filesystem::path& 
                                                    const std::string& hint) {
   if (!std::filesystem::exists(file)) return std::nullopt;
   try {
-    return nlohmann::json::parse(read_text(file));
+    return parse_json(read_text(file));
   } catch (const nlohmann::json::parse_error& error) {
     throw InvalidInputError(file.string() + ": not JSON (" + error.what() + "); " + hint);
   }

@@ -31,6 +31,7 @@
 #include <system_error>
 #include <utility>
 
+#include "core/bounded_yaml.h"
 #include "core/errors.h"
 #include "core/mesh/io/mesh_io.h"
 #include "core/suggest.h"
@@ -1539,7 +1540,7 @@ std::vector<Problem> parse_manifest(const std::string& text, Atlas& atlas) {
   AtlasReader r;
   YAML::Node root;
   try {
-    const std::vector<YAML::Node> documents = YAML::LoadAll(text);
+    const std::vector<YAML::Node> documents = load_all_yaml(text);
     if (documents.size() > 1) {
       r.report(documents[1].Mark(), "top level",
                "holds " + std::to_string(documents.size()) +

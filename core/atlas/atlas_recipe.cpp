@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/bounded_yaml.h"
 #include "core/errors.h"
 
 namespace mmm::atlas {
@@ -150,7 +151,7 @@ void check_unique(const RecipeReader& reader, const YAML::Node& root, const std:
 AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file.string());
+    root = load_yaml_file(file);
   } catch (const YAML::BadFile&) {
     throw IoError(file, "cannot open the recipe (check the path)");
   } catch (const YAML::Exception& error) {

@@ -1,20 +1,19 @@
 #pragma once
-// SHA-256 message digest (NIST FIPS 180-4, section 6.2), written from the
-// standard. Used to name content-addressed artifacts and to check that a
-// stored file still holds the bytes it was written with.
-//
-// The idea: pad the message to a multiple of 64 bytes (a 1 bit, zeros, then
-// the message length in bits as a big-endian 64-bit number) and feed each
-// 64-byte block through the compression function, which expands the block to
-// 64 words (message schedule) and mixes them into eight 32-bit state words over
-// 64 rounds. The digest is the final state, big-endian.
+// SHA-256 message digest (NIST FIPS 180-4), computed by OpenSSL's EVP
+// interface (the SHA extensions of the processor when it has them). Used to
+// name content-addressed artifacts, to check that a stored file still holds
+// the bytes it was written with, and for the audit trail's hash chain.
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
+
+// OpenSSL's digest context (EVP_MD_CTX), kept out of this header.
+struct evp_md_ctx_st;
 
 namespace mmm::hash {
 
@@ -27,6 +26,11 @@ using Sha256Digest = std::array<std::uint8_t, 32>;
 class Sha256 {
  public:
   Sha256();
+  ~Sha256();
+  Sha256(const Sha256&) = delete;
+  Sha256& operator=(const Sha256&) = delete;
+  Sha256(Sha256&&) noexcept;
+  Sha256& operator=(Sha256&&) noexcept;
 
   // Appends bytes to the message.
   void update(std::string_view bytes);
@@ -36,14 +40,10 @@ class Sha256 {
   [[nodiscard]] Sha256Digest finish();
 
  private:
-  // Mixes `block_count` consecutive 64-byte blocks into state_.
-  void compress(const std::uint8_t* blocks, std::size_t block_count);
-  void reset();
-
-  std::array<std::uint32_t, 8> state_{};
-  std::array<std::uint8_t, 64> buffer_{};  // pending bytes of an incomplete block
-  std::size_t buffered_ = 0;               // number of valid bytes in buffer_
-  std::uint64_t length_ = 0;               // message length so far (bytes)
+  struct ContextDeleter {
+    void operator()(evp_md_ctx_st* context) const;
+  };
+  std::unique_ptr<evp_md_ctx_st, ContextDeleter> context_;
 };
 
 // 64 lowercase hexadecimal characters of a digest.

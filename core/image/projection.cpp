@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/file_bytes.h"
 #include "core/image/file_bytes.h"
@@ -234,7 +235,7 @@ class SidecarReader {
   std::vector<RadiographFile> parse(const std::string& text) const {
     Json root;
     try {
-      root = Json::parse(text);
+      root = parse_json(text);
     } catch (const Json::parse_error& error) {
       parse_failure(text, error);
     }

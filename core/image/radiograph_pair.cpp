@@ -5,6 +5,7 @@
 #include <variant>
 
 #include "core/base64.h"
+#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/hash/sha256.h"
 #include "core/image/file_bytes.h"
@@ -113,7 +114,7 @@ std::string radiograph_pair_to_json_text(const RadiographPair& pair) {
   Json root;
   root["format"] = kFormat;
   root["version"] = kVersion;
-  root["calibration"] = Json::parse(view_sidecar_text(pair.views));
+  root["calibration"] = parse_json(view_sidecar_text(pair.views));
   Json images = Json::object();
   for (const RadiographFile& file : pair.views) {
     const std::string& png = pair.images.at(file.image);
@@ -126,7 +127,7 @@ std::string radiograph_pair_to_json_text(const RadiographPair& pair) {
 RadiographPair radiograph_pair_from_json_text(const std::string& text, const fs::path& source) {
   Json root;
   try {
-    root = Json::parse(text);
+    root = parse_json(text);
   } catch (const Json::parse_error& error) {
     throw IoError(source, std::string("is not a radiograph pair (JSON): ") + error.what());
   }

@@ -7,6 +7,7 @@
 #include <set>
 #include <string_view>
 
+#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/landmarks/message_text.h"
 
@@ -240,7 +241,7 @@ LandmarkSet landmark_set_from_json_text(std::string_view text, std::string_view 
   const Reader reader(what);
   Json root;
   try {
-    root = Json::parse(text);
+    root = parse_json(text);
   } catch (const Json::parse_error& error) {
     reader.fail(
         "", std::string("not valid JSON (NaN and Infinity are not JSON numbers): ") + error.what());

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <system_error>
 
+#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/file_bytes.h"
 #include "core/landmarks/message_text.h"
@@ -59,7 +60,7 @@ class MarkupsReader {
     const std::string text = read_text(file_);
     Json root;
     try {
-      root = Json::parse(text);
+      root = parse_json(text);
     } catch (const Json::parse_error& error) {
       fail("", std::string("not valid JSON: ") + error.what());
     }

@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/bounded_yaml.h"
 #include "core/errors.h"
 #include "core/suggest.h"
 
@@ -150,7 +151,7 @@ MarkerMapping parse_marker_mapping(std::string_view text,
                                    const std::filesystem::path& name_for_messages) {
   YAML::Node root;
   try {
-    root = YAML::Load(std::string(text));
+    root = load_yaml(text);
   } catch (const YAML::Exception& error) {
     throw IoError(name_for_messages,
                   "line " + std::to_string(error.mark.line + 1) + ": malformed YAML: " + error.msg);
@@ -161,7 +162,7 @@ MarkerMapping parse_marker_mapping(std::string_view text,
 MarkerMapping read_marker_mapping(const std::filesystem::path& file) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file.string());
+    root = load_yaml_file(file);
   } catch (const YAML::BadFile&) {
     throw IoError(file, "cannot open the marker mapping (check the path)");
   } catch (const YAML::Exception& error) {

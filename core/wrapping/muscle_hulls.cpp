@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string_view>
 
+#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/file_bytes.h"
 #include "core/hash/sha256.h"
@@ -130,7 +131,7 @@ std::vector<MuscleHull> read_hulls(const std::filesystem::path& dir) {
                          std::istreambuf_iterator<char>());
   std::vector<MuscleHull> hulls;
   try {
-    const nlohmann::json index = nlohmann::json::parse(text);
+    const nlohmann::json index = parse_json(text);
     for (const nlohmann::json& entry : index.at("hulls")) {
       MuscleHull hull;
       hull.muscle = entry.at("muscle").get<std::string>();

@@ -121,6 +121,33 @@ TEST_F(StationCliTest, PauseSubmitRejectedThenAcceptedResumesAndTheAuditVerifies
   EXPECT_NE(tampered.err.find("entry 2"), std::string::npos) << tampered.err;
 }
 
+// A submission file nested 100,000 levels deep (it used to crash mmm) or
+// larger than a submission can be is refused with the reason; the task stays
+// claimed and a proper submission then goes through.
+TEST_F(StationCliTest, DeepOrHugeSubmissionFilesAreRefusedAndTheTaskStaysOpen) {
+  ASSERT_EQ(run_mmm("run " + study_.string() + " -q").exit_code, 3);
+  const std::string id = task_id();
+  const std::string task = " --root " + root_.string() + " --operator ana";
+  ASSERT_EQ(run_mmm("task claim " + id + task).exit_code, 0);
+
+  const fs::path deep =
+      test::write_file(dir_ / "deep.json", std::string(100000, '[') + std::string(100000, ']'));
+  const CommandResult refused = run_mmm("task submit " + id + task + " --file " + deep.string());
+  EXPECT_EQ(refused.exit_code, 1) << refused.err;
+  EXPECT_NE(refused.err.find("nested more than 64 levels"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("deep.json"), std::string::npos) << refused.err;
+
+  const fs::path huge = test::write_file(dir_ / "huge.json", std::string(2 << 20, ' ') + "{}");
+  const CommandResult too_big = run_mmm("task submit " + id + task + " --file " + huge.string());
+  EXPECT_EQ(too_big.exit_code, 1);
+  EXPECT_NE(too_big.err.find("a submission is at most 1048576"), std::string::npos) << too_big.err;
+
+  const CommandResult accepted =
+      run_mmm("task submit " + id + task + point("femoral_head_centre_r", {90, 0, 900}) +
+              point("patella_centre_r", {80, 30, 480}));
+  EXPECT_EQ(accepted.exit_code, 0) << accepted.out << accepted.err;
+}
+
 // mmm report on a study that has only its landmarks: the audit section names
 // who submitted which landmarks, the later sections say they are not computed
 // yet, and the page is offline (no scripts, no links out).

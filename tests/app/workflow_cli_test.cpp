@@ -65,6 +65,18 @@ TEST(WorkflowCliTest, ValidateMissingFileExitsOne) {
   EXPECT_THAT(result.err, HasSubstr("/nonexistent/wf.yaml: no such file\n"));
 }
 
+// A node that contains itself through an alias used to crash `mmm validate`,
+// and ~700 bytes of nested aliases kept it busy for minutes.
+TEST(WorkflowCliTest, SelfReferencingAndExplodingAliasesAreReportedNotFollowed) {
+  const CommandResult self = run_mmm("validate " + malformed("self_alias.yaml"));
+  EXPECT_EQ(self.exit_code, 1);
+  EXPECT_THAT(self.err, HasSubstr("self_alias.yaml:3:12: YAML syntax error: an alias names a node "
+                                  "that contains it"));
+  const CommandResult bomb = run_mmm("validate " + malformed("alias_bomb.yaml"));
+  EXPECT_EQ(bomb.exit_code, 1);
+  EXPECT_THAT(bomb.err, HasSubstr("more than 2000000 nodes"));
+}
+
 TEST(WorkflowCliTest, GraphPrintsDotForAValidWorkflow) {
   const CommandResult result = run_mmm("graph " + example());
   ASSERT_EQ(result.exit_code, 0) << result.err;

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <functional>
 #include <thread>
 
 #include "core/image/png.h"
@@ -17,6 +18,7 @@
 #include "workflow/run/run_study.h"
 #include "workflow/run/study_plan.h"
 #include "workflow/store/study_lock.h"
+#include "workflow/study/execution_records.h"
 #include "worklists/audit_trail.h"
 #include "worklists/audit_verify.h"
 #include "worklists/landmark_task.h"
@@ -308,6 +310,188 @@ TEST_F(TaskActionsTest, ReviewKeepsASubmissionUntilASecondOperatorAcceptsIt) {
   submit_task(study, id, ana_, submission());
   EXPECT_TRUE(accept_task(study, id, ben_).accepted);
   EXPECT_EQ(run(study).summary->outcome, workflow::RunOutcome::kDone);
+}
+
+// Four eyes: reassigning the submitted task to someone else used to make
+// its submitter an acceptable reviewer of their own values.
+TEST_F(TaskActionsTest, TheSubmitterNeverReviewsWhoeverTheTaskIsAssignedTo) {
+  Study study = open();
+  study.set_param("landmarks", "review", "true");
+  const std::string id = pause(study);
+  claim_task(study, id, ana_);
+  ASSERT_TRUE(submit_task(study, id, ana_, submission()).awaiting_review);
+  EXPECT_EQ(find_task(study.database(), id)->submitted_by, "ana");
+  reassign_task(study, id, ana_, "ben");
+  EXPECT_EQ(find_task(study.database(), id)->assignee, "ben");
+  try {
+    accept_task(study, id, ana_);
+    FAIL() << "the submitter reviewed their own values";
+  } catch (const TaskError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("rule: four eyes"));
+  }
+  EXPECT_THROW(reject_task(study, id, ana_, {"never mind"}), TaskError);
+  EXPECT_EQ(find_task(study.database(), id)->state, TaskState::kSubmitted);
+  EXPECT_TRUE(accept_task(study, id, ben_).accepted);
+}
+
+// A correction of a node that asks for review used to be applied at once.
+TEST_F(TaskActionsTest, ACorrectionOfAReviewedNodeWaitsForASecondOperator) {
+  Study study = open();
+  study.set_param("landmarks", "review", "true");
+  const std::string id = pause(study);
+  claim_task(study, id, ana_);
+  submit_task(study, id, ana_, submission(false));
+  ASSERT_TRUE(accept_task(study, id, ben_).accepted);
+  ASSERT_EQ(run(study).summary->outcome, workflow::RunOutcome::kDone);
+  const Json accepted = find_task(study.database(), id)->result;
+
+  const SubmitOutcome pending = submit_task(study, id, ben_, submission(), "ankle centre added");
+  EXPECT_TRUE(pending.awaiting_review);
+  EXPECT_TRUE(pending.correction);
+  EXPECT_FALSE(pending.accepted);
+  Task task = *find_task(study.database(), id);
+  EXPECT_EQ(task.state, TaskState::kAccepted);
+  EXPECT_EQ(task.result, accepted) << "the accepted values stay in force";
+  EXPECT_EQ(task.pending_correction["by"], "ben");
+  EXPECT_TRUE(run(study).summary->executed.empty()) << "nothing re-runs before the review";
+  EXPECT_EQ(list_worklist(root_.path()).size(), 1U) << "the correction waits on the worklist";
+  EXPECT_THROW(submit_task(study, id, ana_, submission(), "another"), TaskError)
+      << "one correction at a time";
+  EXPECT_THROW(accept_task(study, id, ben_), TaskError) << "four eyes for corrections too";
+
+  const SubmitOutcome reviewed = accept_task(study, id, ana_);
+  EXPECT_TRUE(reviewed.accepted);
+  EXPECT_TRUE(reviewed.correction);
+  task = *find_task(study.database(), id);
+  EXPECT_TRUE(task.pending_correction.is_null());
+  EXPECT_EQ(task.submitted_by, "ben");
+  EXPECT_NE(task.result, accepted);
+  EXPECT_THAT(run(study).summary->executed, ElementsAre("count"));
+
+  // A rejected correction leaves the accepted values as they were.
+  const Json current = task.result;
+  ASSERT_TRUE(submit_task(study, id, ana_, submission(false), "ankle unsure").awaiting_review);
+  reject_task(study, id, ben_, {"the ankle is clearly visible"});
+  task = *find_task(study.database(), id);
+  EXPECT_EQ(task.state, TaskState::kAccepted);
+  EXPECT_EQ(task.result, current);
+  EXPECT_TRUE(task.pending_correction.is_null());
+  EXPECT_TRUE(run(study).summary->executed.empty());
+  EXPECT_TRUE(verify_audit(study.database(), study.dir()).intact);
+}
+
+TEST_F(TaskActionsTest, BlankReasonsAreNotReasons) {
+  Study study = open();
+  study.set_param("landmarks", "review", "true");
+  const std::string id = pause(study);
+  claim_task(study, id, ana_);
+  EXPECT_THROW(cancel_task(study, id, ana_, "   "), TaskError) << "cancel";
+  submit_task(study, id, ana_, submission(false));
+  EXPECT_THROW(reject_task(study, id, ben_, {"  "}), TaskError) << "reject";
+  EXPECT_THROW(reject_task(study, id, ben_, {"fine", ""}), TaskError) << "every reason";
+  EXPECT_EQ(find_task(study.database(), id)->state, TaskState::kSubmitted);
+  ASSERT_TRUE(accept_task(study, id, ben_).accepted);
+  EXPECT_THROW(submit_task(study, id, ben_, submission(), " \t "), TaskError) << "correction";
+  EXPECT_TRUE(find_task(study.database(), id)->pending_correction.is_null());
+}
+
+// Anyone could take over or cancel the task another operator had claimed.
+TEST_F(TaskActionsTest, OnlyTheAssigneeOrASupervisorReleasesReassignsOrCancelsAClaimedTask) {
+  Study study = open();
+  const std::string id = pause(study);
+  claim_task(study, id, ana_);
+  for (const auto& attempt : std::vector<std::function<void()>>{
+           [&] { reassign_task(study, id, ben_, "ben"); }, [&] { release_task(study, id, ben_); },
+           [&] { cancel_task(study, id, ben_, "taking over"); }}) {
+    try {
+      attempt();
+      FAIL() << "ben acted on ana's task";
+    } catch (const TaskError& error) {
+      EXPECT_THAT(error.what(), HasSubstr("rule: assignee or supervisor"));
+    }
+  }
+  Task task = *find_task(study.database(), id);
+  EXPECT_EQ(task.state, TaskState::kClaimed);
+  EXPECT_EQ(task.assignee, "ana");
+
+  const Actor sue{"sue", "test", true};
+  reassign_task(study, id, sue, "ben");
+  EXPECT_EQ(find_task(study.database(), id)->assignee, "ben");
+  const std::vector<AuditEntry> trail = read_audit(study.database());
+  ASSERT_FALSE(trail.empty());
+  EXPECT_EQ(trail.back().action, "reassign");
+  EXPECT_EQ(trail.back().operator_name, "sue") << "the audit says who";
+  release_task(study, id, ben_);
+  EXPECT_EQ(find_task(study.database(), id)->state, TaskState::kOpen);
+}
+
+TEST_F(TaskActionsTest, ReservedNamesCannotAct) {
+  Study study = open();
+  const std::string id = pause(study);
+  for (const char* name : {"mmm", "System", "ROOT", "admin"}) {
+    try {
+      claim_task(study, id, {name, "test"});
+      FAIL() << name << " claimed a task";
+    } catch (const TaskError& error) {
+      EXPECT_THAT(error.what(), HasSubstr("is reserved")) << name;
+    }
+  }
+  EXPECT_EQ(find_task(study.database(), id)->state, TaskState::kOpen);
+}
+
+// An intact chain used to be reported "intact" however the tasks table and
+// the accepted results had been edited, and with every entry deleted.
+TEST_F(TaskActionsTest, VerifyCrossChecksTheTasksAndTheirResultsAgainstTheTrail) {
+  Study study = open();
+  const std::string id = pause(study);
+  claim_task(study, id, ana_);
+  ASSERT_TRUE(submit_task(study, id, ana_, submission()).accepted);
+  ASSERT_TRUE(verify_audit(study.database(), study.dir()).intact);
+  const auto kinds = [&] {
+    std::vector<AuditProblemKind> found;
+    for (const AuditProblem& problem : verify_audit(study.database(), study.dir()).problems) {
+      found.push_back(problem.kind);
+    }
+    return found;
+  };
+
+  // The femoral head moved 30 mm up in the tasks table.
+  const Json accepted = find_task(study.database(), id)->result;
+  Json forged = accepted;
+  Json& z = forged["landmarks"][0]["position_mm"][2];
+  z = z.get<double>() + 30.0;
+  const auto set_result = [&](const Json& result) {
+    study.database()
+        .prepare("UPDATE tasks SET result_json = ? WHERE id = ?")
+        .bind_text(1, result.dump())
+        .bind_text(2, id)
+        .step();
+  };
+  set_result(forged);
+  EXPECT_THAT(kinds(), ElementsAre(AuditProblemKind::kValueMismatch));
+  set_result(accepted);
+  EXPECT_TRUE(verify_audit(study.database(), study.dir()).intact);
+
+  // The stored result edited in place.
+  const std::string hash =
+      workflow::last_done_execution(study.database(), "landmarks")->outputs.at("landmarks").hash;
+  const fs::path blob = study.artifacts().path_of(hash);
+  const std::string original = test::read_text(blob);
+  fs::permissions(blob, fs::perms::owner_write, fs::perm_options::add);
+  test::write_file(blob, original + " ");
+  EXPECT_THAT(kinds(), ElementsAre(AuditProblemKind::kArtifactChanged));
+  test::write_file(blob, original);
+  EXPECT_TRUE(verify_audit(study.database(), study.dir()).intact);
+
+  // Every entry deleted (and the checkpoint with them).
+  study.database().exec(
+      "DROP TRIGGER IF EXISTS audit_no_update; DROP TRIGGER IF EXISTS audit_no_delete; "
+      "DELETE FROM audit; DELETE FROM meta WHERE key = 'audit_head';");
+  fs::remove(audit_checkpoint_path(study.dir()));
+  const AuditVerification emptied = verify_audit(study.database(), study.dir());
+  EXPECT_FALSE(emptied.intact);
+  EXPECT_EQ(emptied.entries, 0);
+  EXPECT_THAT(kinds(), ::testing::Contains(AuditProblemKind::kTaskUnaudited));
 }
 
 TEST_F(TaskActionsTest, ChangedInputsCancelTheOldTaskAndOpenANewOne) {

@@ -9,6 +9,7 @@
 #include <system_error>
 #include <utility>
 
+#include "core/bounded_yaml.h"
 #include "core/errors.h"
 #include "core/suggest.h"
 #include "workflow/definition/workflow_validation.h"
@@ -257,7 +258,7 @@ std::optional<YAML::Node> parse_document(std::string_view text, Collector& out) 
   }
   std::vector<YAML::Node> documents;
   try {
-    documents = YAML::LoadAll(std::string(text));
+    documents = load_all_yaml(text);
   } catch (const YAML::Exception& e) {
     const SourceLocation where = e.mark.is_null()
                                      ? SourceLocation{1, 1}

@@ -16,6 +16,7 @@
 #include <set>
 #include <utility>
 
+#include "core/bounded_yaml.h"
 #include "core/errors.h"
 #include "core/suggest.h"
 #include "workflow/definition/yaml_scalar.h"
@@ -529,7 +530,7 @@ YamlSchema YamlSchema::from_yaml(const YAML::Node& root, const std::string& orig
 YamlSchema YamlSchema::from_text(std::string_view text, const std::string& origin) {
   YAML::Node root;
   try {
-    root = YAML::Load(std::string(text));
+    root = load_yaml(text);
   } catch (const YAML::Exception& e) {
     throw InvalidInputError(origin + ":" + std::to_string(e.mark.line + 1) + ":" +
                             std::to_string(e.mark.column + 1) +

@@ -222,6 +222,19 @@ Completion execute(const Job& job, ArtifactStore& artifacts,
     if (observer != nullptr) observer->node_log(job.node, level, message);
   };
   try {
+    // Every input is checked against its content hash right before the node
+    // reads it: an artifact changed in place (by hand, or by a disk fault)
+    // fails the node instead of flowing into its results.
+    for (const auto& [port, ref] : job.inputs) {
+      if (!artifacts.verify(ref.hash)) {
+        throw IoError(ref.path, "input '" + port + "' of node '" + job.node +
+                                    "' is missing or was changed after it was stored (its "
+                                    "content no longer hashes to " +
+                                    ref.hash +
+                                    "); hint: 'mmm audit verify' on the study, then re-run or "
+                                    "restore the node that produced it");
+      }
+    }
     std::filesystem::create_directories(scratch);
     NodeContext context(job.type->spec, job.inputs, job.params, scratch, channels);
     fault_point("node.before_run");

@@ -5,6 +5,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -90,6 +93,12 @@ std::string input_value_hint(PortType type) {
 // bundle. Returns the artifact hash.
 std::string store_origin(ArtifactStore& artifacts, const std::filesystem::path& origin,
                          const FileStamp& stamp) {
+  if (stamp.size > kMaxStudyInputBytes) {
+    throw IoError(origin, std::string(stamp.is_directory ? "holds " : "is ") +
+                              std::to_string(stamp.size) + " bytes; a study input is at most " +
+                              std::to_string(kMaxStudyInputBytes) +
+                              " (1 GiB); hint: check that this is the file you meant");
+  }
   return stamp.is_directory ? artifacts.put(pack_directory(origin)) : artifacts.put_file(origin);
 }
 
@@ -138,11 +147,49 @@ void write_file_durably(const std::filesystem::path& file, std::string_view byte
   }
 }
 
-// A fresh sibling folder name for building the study before it appears.
+// The prefix of the hidden sibling folders in which `dir` is built.
+std::string staging_prefix(const std::filesystem::path& dir) {
+  return "." + dir.filename().string() + ".creating-";
+}
+
+// A fresh sibling folder name for building the study before it appears:
+// PREFIX<pid>-<random>-<host>, so that a later create can tell an abandoned one.
 std::filesystem::path staging_dir_for(const std::filesystem::path& dir) {
   std::random_device random;
-  return dir.parent_path() /
-         ("." + dir.filename().string() + ".creating-" + std::to_string(random()));
+  return dir.parent_path() / (staging_prefix(dir) + std::to_string(::getpid()) + "-" +
+                              std::to_string(random()) + "-" + host_name());
+}
+
+// Removes the staging folders of earlier creates of `dir` that were killed
+// before they could clean up: made on this machine by a process that is gone,
+// or (another machine's, on a shared file system) a day old.
+void remove_abandoned_staging(const std::filesystem::path& dir) {
+  const std::string prefix = staging_prefix(dir);
+  const std::string this_host = host_name();
+  const auto now = std::filesystem::file_time_type::clock::now();
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.parent_path(), error)) {
+    const std::string name = entry.path().filename().string();
+    if (!name.starts_with(prefix)) continue;
+    const std::string rest = name.substr(prefix.size());  // pid-random-host
+    const std::size_t first = rest.find('-');
+    const std::size_t second = first == std::string::npos ? first : rest.find('-', first + 1);
+    bool abandoned = false;
+    if (second != std::string::npos && rest.substr(second + 1) == this_host) {
+      long pid = 0;
+      try {
+        pid = std::stol(rest.substr(0, first));
+      } catch (const std::exception&) {
+        pid = 0;
+      }
+      abandoned = pid <= 0 || (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH);
+    } else {
+      std::error_code time_error;
+      const auto written = std::filesystem::last_write_time(entry.path(), time_error);
+      abandoned = !time_error && now - written > std::chrono::hours(24);
+    }
+    if (abandoned) std::filesystem::remove_all(entry.path(), error);
+  }
 }
 
 void insert_meta(Database& database, const std::string& key, const std::string& value) {
@@ -201,6 +248,7 @@ Study Study::create(const std::filesystem::path& dir, const CreateStudyOptions& 
   // that a failure (bad input file, full disk, crash) leaves nothing behind.
   const std::filesystem::path absolute_dir = std::filesystem::absolute(dir).lexically_normal();
   std::filesystem::create_directories(absolute_dir.parent_path(), error);
+  remove_abandoned_staging(absolute_dir);
   const std::filesystem::path staging = staging_dir_for(absolute_dir);
   std::filesystem::create_directory(staging, error);
   if (error) throw IoError(staging, "cannot create the study folder: " + error.message());

@@ -30,6 +30,10 @@
 
 namespace mmm::workflow {
 
+// The largest study input: a file's size, or the sum of a folder's files. A
+// larger one is refused (naming this limit) before anything is copied.
+inline constexpr std::int64_t kMaxStudyInputBytes = std::int64_t{1} << 30;
+
 // The program that creates or runs a study, recorded with it.
 struct Provenance {
   std::string mmm_version;   // e.g. "0.1.0"
@@ -63,7 +67,8 @@ class Study {
   // every input into the artifact store and records provenance. Throws
   // InvalidInputError listing every problem (workflow diagnostics with
   // file:line:col, unknown, missing or ill-typed inputs) and IoError for file
-  // problems; on failure nothing is left behind.
+  // problems; on failure nothing is left behind. The hidden staging folders
+  // of earlier creates of `dir` that were killed meanwhile are removed.
   static Study create(const std::filesystem::path& dir, const CreateStudyOptions& options,
                       const NodeRegistry& registry);
 

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/image/radiograph_pair.h"
 #include "workflow/run/study_plan.h"
@@ -69,7 +70,7 @@ std::string bearer_token(const httplib::Request& request) {
 
 Json parse_body(const httplib::Request& request) {
   if (request.body.empty()) return Json::object();
-  Json body = Json::parse(request.body, nullptr, false);
+  Json body = parse_json_or_discarded(request.body);
   if (body.is_discarded() || !body.is_object()) {
     throw BadRequestError("the request body is not a JSON object");
   }
@@ -191,7 +192,7 @@ struct StationServer::Impl {
   }
 
   [[nodiscard]] Actor actor(const std::string& operator_name) const {
-    return {operator_name, options.mmm_version};
+    return {operator_name, options.mmm_version, is_supervisor(options.root, operator_name)};
   }
 
   // The study folder called `study` (its path relative to the root, as the
@@ -451,6 +452,14 @@ StationServer::StationServer(ServerOptions options, const workflow::NodeRegistry
   impl.routes();
   // A submission is a few kilobytes; anything much larger is a mistake.
   impl.server.set_payload_max_length(std::size_t{1} << 20U);
+  // cpp-httplib's default socket options add SO_REUSEPORT, with which a
+  // second server binds the port of a running one without an error (and the
+  // kernel splits the connections between them). Only SO_REUSEADDR: a
+  // restart right after a stop still binds, a taken port is an error.
+  impl.server.set_socket_options([](::socket_t sock) {
+    const int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
   const std::string address = impl.options.host + ":" + std::to_string(impl.options.port);
   if (impl.options.port == 0) {
     impl.port = impl.server.bind_to_any_port(impl.options.host);

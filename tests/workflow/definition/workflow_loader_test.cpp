@@ -55,6 +55,8 @@ INSTANTIATE_TEST_SUITE_P(
         MalformedCase{"not_yaml.yaml", 1, 1, "not a workflow file: the top level is string"},
         MalformedCase{"yaml_syntax.yaml", 7, 11, "YAML syntax error: end of map flow not found"},
         MalformedCase{"two_documents.yaml", 8, 1, "holds 2 YAML documents"},
+        MalformedCase{"self_alias.yaml", 3, 12, "an alias names a node that contains it"},
+        MalformedCase{"alias_bomb.yaml", 10, 10, "more than 2000000 nodes (an alias bomb?)"},
         // Structure (the schema).
         MalformedCase{"missing_nodes.yaml", 1, 1, "top level: missing required key 'nodes'"},
         MalformedCase{"wrong_version.yaml", 1, 15, "mmm_workflow: expected 1, got integer 2"},

@@ -172,6 +172,25 @@ TEST_F(SchedulerTest, AFailureBlocksItsDownstreamWhileOtherBranchesFinish) {
   EXPECT_EQ(fixed.outcome, RunOutcome::kDone);
 }
 
+// An artifact edited in place used to flow into the next computation.
+TEST_F(SchedulerTest, AnInputChangedInPlaceFailsTheNodeThatWouldReadIt) {
+  Study study = create(kDiamond);
+  run(study);
+  const std::string hash = last_done_execution(study.database(), "c")->outputs.at("out").hash;
+  const std::filesystem::path blob = study.artifacts().path_of(hash);
+  std::filesystem::permissions(blob, std::filesystem::perms::owner_write,
+                               std::filesystem::perm_options::add);
+  test::write_file(blob, "1000.0");  // c's result was 3
+  study.set_param("d", "offset", "20");
+  const RunSummary rerun = run(study);
+  EXPECT_EQ(rerun.outcome, RunOutcome::kFailed);
+  EXPECT_THAT(rerun.failed, ElementsAre("d"));
+  const std::optional<ExecutionRecord> record = last_execution(study.database(), "d");
+  ASSERT_TRUE(record.has_value());
+  EXPECT_THAT(record->error, ::testing::HasSubstr("input 'b' of node 'd' is missing or was "
+                                                  "changed after it was stored"));
+}
+
 TEST_F(SchedulerTest, AManualNodeMakesTheStudyWaitAndBlocksOnlyItsDownstream) {
   Study study = create(R"yaml(mmm_workflow: 1
 name: manual

@@ -4,6 +4,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "core/directory_bundle.h"
 #include "core/errors.h"
 #include "tests/support/test_data.h"
+#include "workflow/host_and_time.h"
 #include "workflow/study/study.h"
 
 namespace mmm::workflow {
@@ -154,6 +156,42 @@ TEST_F(StudyFolderInputTest, AnAtlasFolderThatCannotBePackedIsAnIoError) {
   fs::create_symlink(surface_, atlas_ / "outside.stl");
   EXPECT_THROW((void)create(atlas_.string(), surface_.string()), IoError);
   EXPECT_FALSE(fs::exists(scratch_ / "study"));
+}
+
+// A 2 GB input used to be copied whole into the study before anything
+// looked at its size.
+TEST_F(StudyFolderInputTest, AnInputOverTheLimitIsRefusedBeforeAnythingIsCopied) {
+  const fs::path big = scratch_ / "big.stl";
+  test::write_file(big, "solid s\n");
+  fs::resize_file(big, static_cast<std::uintmax_t>(kMaxStudyInputBytes) + 1);  // sparse
+  try {
+    (void)create(atlas_.string(), big.string());
+    FAIL() << "no error";
+  } catch (const IoError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("big.stl"));
+    EXPECT_THAT(error.what(), HasSubstr("a study input is at most 1073741824 (1 GiB)"));
+  }
+  EXPECT_FALSE(fs::exists(scratch_ / "study"));
+  for (const auto& entry : fs::directory_iterator(scratch_.path())) {
+    EXPECT_FALSE(entry.path().filename().string().starts_with(".study.creating-")) << entry.path();
+  }
+}
+
+// A killed `study create` leaves its hidden staging folder; the next create
+// of the same study removes it when its process is gone, and leaves those of
+// a live process and of another machine alone.
+TEST_F(StudyFolderInputTest, TheStagingFolderOfAKilledCreateIsRemovedByTheNextOne) {
+  const std::string prefix = ".study.creating-";
+  const fs::path dead = scratch_ / (prefix + "999999999-1-" + host_name());
+  const fs::path live = scratch_ / (prefix + std::to_string(::getpid()) + "-2-" + host_name());
+  const fs::path elsewhere = scratch_ / (prefix + "999999999-3-another-machine.example");
+  for (const fs::path& staging : {dead, live, elsewhere}) {
+    test::write_file(staging / "artifacts/blob", std::string(1000, 'x'));
+  }
+  (void)create(atlas_.string(), surface_.string());
+  EXPECT_FALSE(fs::exists(dead));
+  EXPECT_TRUE(fs::exists(live));
+  EXPECT_TRUE(fs::exists(elsewhere)) << "may belong to a create running on another machine";
 }
 
 }  // namespace
