@@ -4,11 +4,12 @@
 #include <yaml-cpp/parser.h>
 
 #include <algorithm>
-#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
 #include <system_error>
+
+#include "core/file_bytes.h"
 
 namespace mmm {
 namespace {
@@ -149,13 +150,9 @@ YAML::Node load_yaml(std::string_view text, const YamlLimits& limits) {
 YAML::Node load_yaml_file(const std::filesystem::path& file, const YamlLimits& limits) {
   std::error_code error;
   const std::uintmax_t size = std::filesystem::file_size(file, error);
-  std::ifstream in(file, std::ios::binary);
-  if (error || !in) throw YAML::BadFile(file.string());
+  if (error) throw YAML::BadFile(file.string());
   check_size(static_cast<std::size_t>(size), limits);
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
-  return load_yaml(text, limits);
+  return load_yaml(read_file_bytes(file, size), limits);
 }
 
 }  // namespace mmm

@@ -4,17 +4,16 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "app/commands/commands.h"
 #include "core/bounded_json.h"
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "mmm_git_revision.h"
 #include "workflow/study/study.h"
 #include "worklists/audit_export.h"
@@ -159,16 +158,13 @@ Json read_submission(const TaskArgs& args) {
     constexpr std::uintmax_t kMaxSubmissionBytes = std::uintmax_t{1} << 20;
     std::error_code size_error;
     const std::uintmax_t size = std::filesystem::file_size(args.file, size_error);
-    std::ifstream in(args.file);
-    if (size_error || !in) throw IoError(args.file, "cannot be read; hint: check the path");
+    if (size_error) throw IoError(args.file, "cannot be read; hint: check the path");
     if (size > kMaxSubmissionBytes) {
       throw IoError(args.file, "is " + std::to_string(size) + " bytes; a submission is at most " +
                                    std::to_string(kMaxSubmissionBytes) + " (1 MiB)");
     }
-    std::stringstream text;
-    text << in.rdbuf();
     try {
-      submission = parse_json(text.str());
+      submission = parse_json(read_file_bytes(args.file, size));
     } catch (const Json::parse_error& error) {
       throw IoError(args.file, std::string("is not valid JSON (") + error.what() +
                                    "); hint: {\"landmarks\": {NAME: {VIEW: [u, v]}}}");
