@@ -22,6 +22,10 @@ function(mmm_target_settings target)
     if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
       target_compile_options(${target} PRIVATE -Wno-maybe-uninitialized)
     endif()
+    if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang" AND MMM_SANITIZE MATCHES "undefined")
+      target_compile_options(${target} PRIVATE
+        -fsanitize-ignorelist=${PROJECT_SOURCE_DIR}/cmake/ubsan_third_party_ignorelist.txt)
+    endif()
     # The standard library's own checks (bounds of vector/string/array
     # indexing, front() of an empty container, ...): they cover OpenMesh's
     # property arrays too, whose own assert() checks are off in every build
