@@ -16,7 +16,7 @@ APT_PACKAGES := build-essential cmake ninja-build pkg-config python3 \
   libeigen3-dev libopenmesh-dev libceres-dev libyaml-cpp-dev libspdlog-dev libfmt-dev \
   libtinyxml2-dev nlohmann-json3-dev libcli11-dev libsqlite3-dev zlib1g-dev \
   libgtest-dev libgmock-dev googletest libbenchmark-dev libcpp-httplib-dev \
-  libsuitesparse-dev libssl-dev ccache
+  libsuitesparse-dev libssl-dev libspng-dev ccache
 # The browser test of the operator web UI (tests/web): headless Chromium and
 # npm for playwright-core (nodejs itself may come from Debian or NodeSource).
 WEB_TEST_PACKAGES := chromium
@@ -26,7 +26,7 @@ LINT_PACKAGES := clang-format clang-tidy
 SANITIZER_PACKAGES := clang libclang-rt-14-dev
 
 
-.PHONY: demo test build build-mmm deps deps-lint deps-sanitize configure bench format lint clean
+.PHONY: demo test build build-mmm deps deps-lint deps-sanitize configure bench fuzz format lint clean
 
 # The default study end to end (cmake/demo.sh): the default atlas (built when
 # missing or when its recipe changed), synthetic patient 1 with its calibrated
@@ -70,6 +70,18 @@ deps-lint:
 
 deps-sanitize:
 	@./cmake/install_apt_packages.sh $(SANITIZER_PACKAGES)
+
+# The fuzz targets (fuzz/): a clang build with AddressSanitizer and
+# UndefinedBehaviorSanitizer in build-fuzz/, every regression input, then
+# FUZZ_SECONDS of fuzzing per target (FUZZ_TARGETS: a subset).
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS ?=
+fuzz: deps deps-sanitize
+	cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DMMM_SANITIZE=address,undefined -DMMM_FUZZ=ON \
+	  -DMMM_BUILD_TESTS=OFF -DMMM_BUILD_BENCH=OFF -DMMM_DATA_DIR=$(DATA_DIR)
+	cmake --build build-fuzz -j $(JOBS)
+	./fuzz/run build-fuzz $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 
 bench: build
 	./bench/run $(SUITE)

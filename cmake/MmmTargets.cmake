@@ -33,6 +33,11 @@ function(mmm_target_settings target)
     target_compile_definitions(${target} PRIVATE _GLIBCXX_ASSERTIONS)
     target_link_options(${target} PRIVATE -fsanitize=${MMM_SANITIZE})
   endif()
+  if(MMM_FUZZ)
+    # Coverage feedback for libFuzzer in every library the fuzz targets
+    # link (the sanitizer runtimes provide its hooks to other executables).
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
+  endif()
 endfunction()
 
 # mmm_batched_sources(<out_var> <target> <batch_size> <sources>...): with

@@ -65,15 +65,21 @@ EOT
     exit 0
   fi
   stage "SCRIPTED OPERATOR (not a person): landmark clicks from the patient's ground truth + 1.5 px noise"
+  # The scripted operator signs in like a person: with its own token, kept
+  # in a file only this account can read.
+  token_file=$demo/$operator.token
+  if [[ ! -s $token_file ]]; then
+    (umask 077 && "$mmm" operator add "$operator" --root "$root" --replace >"$token_file")
+  fi
   if [[ $state == open ]]; then
-    "$mmm" task claim "$id" --root "$root" --operator "$operator"
+    "$mmm" task claim "$id" --root "$root" --token-file "$token_file"
   elif [[ $assignee != "$operator" ]]; then
     echo "task $id is claimed by $assignee; leaving it to them (or: mmm task release $id)" >&2
     exit 1
   fi
   "$mmm" patient clicks "$patient" -o "$demo/scripted_clicks.json" --seed 1
   stage "submit; the study resumes: scaling, motion, hulls, wrapping, fibres"
-  "$mmm" task submit "$id" --root "$root" --operator "$operator" \
+  "$mmm" task submit "$id" --root "$root" --token-file "$token_file" \
     --file "$demo/scripted_clicks.json" -j "$jobs"
 fi
 

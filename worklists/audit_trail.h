@@ -58,8 +58,11 @@ namespace mmm::worklists {
 using workflow::Database;
 
 // The actions an entry may record.
-inline constexpr std::array<std::string_view, 9> kAuditActions = {
-    "open", "claim", "release", "submit", "reject", "accept", "correct", "cancel", "reassign"};
+// "override": the next entry's action was taken on the command line without
+// the operator's token, by administrative override (the reason says why).
+inline constexpr std::array<std::string_view, 10> kAuditActions = {
+    "open",   "claim",   "release", "submit",   "reject",
+    "accept", "correct", "cancel",  "reassign", "override"};
 
 // NOLINTNEXTLINE(bugprone-exception-escape): nlohmann::json's noexcept move only asserts
 struct AuditEntry {

@@ -400,6 +400,10 @@ std::string_view audit_problem_kind_name(AuditProblemKind kind) {
       return "value_mismatch";
     case AuditProblemKind::kArtifactChanged:
       return "artifact_changed";
+    case AuditProblemKind::kAnchorMissing:
+      return "anchor_missing";
+    case AuditProblemKind::kAnchorMismatch:
+      return "anchor_mismatch";
   }
   return "unknown";
 }

@@ -62,6 +62,9 @@ enum class AuditProblemKind {
   kTaskUnaudited,    // seq: 0; a task no entry opened
   kValueMismatch,    // seq: the last accept/correct entry of the task (0: none)
   kArtifactChanged,  // seq: as kValueMismatch; a result artifact edited in place
+  // Against an external anchor log (audit_anchor.h), when one is given:
+  kAnchorMissing,   // seq: 0; the log holds no anchor of this study
+  kAnchorMismatch,  // seq: the anchored entry, gone or with another hash
 };
 
 // "edited", "deleted", ..., "checkpoint_behind", "meta_mismatch".

@@ -42,6 +42,16 @@ Json images_of(const Task& task) { return task.request.value("images", Json::obj
 // Appends the audit entry of one action (inside the caller's transaction).
 void audit(Study& study, const Actor& actor, const Task& task, const std::string& action,
            const Json& before, const Json& after, const std::string& reason) {
+  if (!actor.override_reason.empty()) {
+    AuditEntry override_entry;
+    override_entry.action = "override";
+    override_entry.operator_name = actor.operator_name;
+    override_entry.task_id = task.id;
+    override_entry.reason =
+        "administrative override for '" + action + "': " + actor.override_reason;
+    override_entry.mmm_version = actor.mmm_version;
+    append_audit_entry(study.database(), std::move(override_entry));
+  }
   AuditEntry entry;
   entry.action = action;
   entry.operator_name = actor.operator_name;

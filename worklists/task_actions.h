@@ -33,6 +33,10 @@ struct Actor {
   std::string operator_name;  // letters, digits, '.', '_', '-', '@'; 1-64 characters
   std::string mmm_version;
   bool supervisor = false;  // registered with the supervisor role (operators.h)
+  // Non-empty: acting without the operator's token, by administrative
+  // override (the command line's --admin-override); each action is preceded
+  // in the audit trail by an "override" entry with this reason.
+  std::string override_reason{};
 };
 
 // The name the runner acts under when it opens or cancels tasks.

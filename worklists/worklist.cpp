@@ -102,20 +102,31 @@ std::vector<WorklistEntry> list_worklist(const fs::path& root, const WorklistFil
   return entries;
 }
 
-WorklistEntry locate_task(const fs::path& root, const std::string& id) {
+WorklistEntry locate_task(const fs::path& root, const std::string& given) {
+  // "STUDY/ID": the task of that study only (a copied study folder keeps the
+  // task ids of the one it was copied from).
+  const std::size_t slash = given.rfind('/');
+  const std::string study = slash == std::string::npos ? "" : given.substr(0, slash);
+  const std::string id = slash == std::string::npos ? given : given.substr(slash + 1);
   if (id.size() < 4) {
     throw InvalidInputError("task id '" + id + "' is too short; hint: give at least 4 characters");
   }
-  std::vector<WorklistEntry> matches;
+  std::vector<WorklistEntry> exact;
+  std::vector<WorklistEntry> prefixed;
   WorklistFilter every;
   every.include_closed = true;
   for (WorklistEntry& entry : list_worklist(root, every)) {
-    if (entry.task.id == id) return std::move(entry);
-    if (entry.task.id.starts_with(id)) matches.push_back(std::move(entry));
+    if (!study.empty() && entry.study != study) continue;
+    if (entry.task.id == id) {
+      exact.push_back(std::move(entry));
+    } else if (entry.task.id.starts_with(id)) {
+      prefixed.push_back(std::move(entry));
+    }
   }
+  std::vector<WorklistEntry>& matches = exact.empty() ? prefixed : exact;
   if (matches.size() == 1) return std::move(matches.front());
   if (matches.empty()) {
-    throw InvalidInputError("no task '" + id + "' in the studies under " + root.string() +
+    throw InvalidInputError("no task '" + given + "' in the studies under " + root.string() +
                             "; hint: 'mmm worklist --root " + root.string() +
                             " --all' lists every task");
   }
@@ -123,7 +134,14 @@ WorklistEntry locate_task(const fs::path& root, const std::string& id) {
   for (const WorklistEntry& entry : matches) {
     ids += (ids.empty() ? "" : ", ") + entry.task.id + " (" + entry.study + ")";
   }
-  throw InvalidInputError("task id prefix '" + id + "' matches several tasks: " + ids);
+  if (!exact.empty()) {
+    throw InvalidInputError("task id '" + id +
+                            "' is in several studies (was a study folder "
+                            "copied?): " +
+                            ids + "; hint: name the study as STUDY/" + id);
+  }
+  throw InvalidInputError("task id prefix '" + id + "' matches several tasks: " + ids +
+                          "; hint: give more characters, or STUDY/ID");
 }
 
 std::string format_age(double seconds) {

@@ -39,8 +39,10 @@ std::vector<WorklistEntry> list_worklist(const std::filesystem::path& root,
                                          const WorklistFilter& filter = {});
 
 // The task with this id (or unique id prefix of at least 4 characters) under
-// root. Throws InvalidInputError when there is none (with a hint) or the
-// prefix is ambiguous (listing the matches).
+// root; "STUDY/ID" looks in that study only (STUDY as the worklist names it).
+// Throws InvalidInputError when there is none (with a hint), when the id is
+// in several studies (a copied study folder keeps its task ids: the studies
+// are named, none is picked) or the prefix is ambiguous (listing the matches).
 WorklistEntry locate_task(const std::filesystem::path& root, const std::string& id);
 
 // "3 h 12 min", "45 s", "2 d 4 h": an age for people.

@@ -25,7 +25,29 @@ struct ServeArgs {
   int port = 8080;
   int jobs = 1;
   double sweep_seconds = 10;
+  std::string tls_certificate;
+  std::string tls_key;
 };
+
+// Whether `host` is an address of this machine only (loopback).
+bool is_loopback(const std::string& host) {
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
+
+// Served beyond this machine: say loudly what that means.
+void warn_about_exposure(const ServeArgs& args) {
+  if (is_loopback(args.host)) return;
+  const bool tls = !args.tls_certificate.empty();
+  std::cerr << "mmm serve: WARNING: listening on " << args.host
+            << ", reachable from other machines. Operator tokens and patient images cross the "
+               "network "
+            << (tls ? "encrypted (HTTPS); check that the certificate is one the operators' "
+                      "browsers trust."
+                    : "IN CLEAR TEXT: anyone on the network path can read them and act as an "
+                      "operator. Give --tls-cert and --tls-key, or keep the default host "
+                      "127.0.0.1 behind an HTTPS reverse proxy.")
+            << std::endl;
+}
 
 std::string content_type(std::string_view name) {
   const auto ends_with = [name](std::string_view suffix) { return name.ends_with(suffix); };
@@ -60,6 +82,8 @@ void run_serve(const ServeArgs& args, const workflow::NodeRegistry& registry) {
   options.root = args.root;
   options.host = args.host;
   options.port = args.port;
+  options.tls_certificate = args.tls_certificate;
+  options.tls_key = args.tls_key;
   options.run.jobs = args.jobs;
   options.run.provenance = {MMM_VERSION, MMM_GIT_REVISION};
   options.mmm_version = MMM_VERSION;
@@ -68,14 +92,16 @@ void run_serve(const ServeArgs& args, const workflow::NodeRegistry& registry) {
   options.files = station_files();
   options.log = [](const std::string& line) { std::cerr << "mmm serve: " << line << std::endl; };
   worklists::http::StationServer server(std::move(options), registry);
+  warn_about_exposure(args);
 
   std::thread stopper([&server, &signals] {
     int signal = 0;
     sigwait(&signals, &signal);
     server.stop();
   });
-  std::cout << "mmm serve: the landmark station of " << args.root << " at http://" << args.host
-            << ':' << server.port() << "/\n"
+  std::cout << "mmm serve: the landmark station of " << args.root << " at "
+            << (args.tls_certificate.empty() ? "http" : "https") << "://" << args.host << ':'
+            << server.port() << "/\n"
             << "operators sign in with their token ('mmm operator add NAME --root " << args.root
             << "'); Ctrl-C stops" << std::endl;
   server.run();
@@ -100,7 +126,7 @@ void register_serve_commands(CLI::App& app, const workflow::NodeRegistry& regist
   serve
       ->add_option("--host", args->host,
                    "Address to listen on (default: this machine only; another address makes "
-                   "the page reachable from the network, without TLS)")
+                   "the page reachable from the network: use --tls-cert and --tls-key)")
       ->capture_default_str();
   serve->add_option("--jobs,-j", args->jobs, "Nodes run at the same time when a study resumes")
       ->check(CLI::Range(1, 256))
@@ -110,6 +136,10 @@ void register_serve_commands(CLI::App& app, const workflow::NodeRegistry& regist
                    "Every SECONDS, resume studies whose accepted work waits (0: never)")
       ->check(CLI::Range(0.0, 86400.0))
       ->capture_default_str();
+  serve->add_option("--tls-cert", args->tls_certificate, "HTTPS: the server's certificate (PEM)")
+      ->check(CLI::ExistingFile);
+  serve->add_option("--tls-key", args->tls_key, "HTTPS: the certificate's private key (PEM)")
+      ->check(CLI::ExistingFile);
   serve->callback([args, &registry] { run_serve(*args, registry); });
 }
 

@@ -10,6 +10,7 @@
 
 #include "app/commands/commands.h"
 #include "core/errors.h"
+#include "workflow/run/export_outputs.h"
 #include "workflow/run/study_plan.h"
 #include "workflow/store/study_lock.h"
 #include "workflow/study/study.h"
@@ -104,7 +105,19 @@ nlohmann::json status_json(workflow::Study& study, const StudyPlan& plan) {
   json["last_run"] = last_run_json(study);
   const bool all_cached =
       plan.count(workflow::NodeState::kCached) == static_cast<int>(plan.nodes.size());
-  json["state"] = all_cached                                      ? "done"
+  // Whether outputs/ shows the current results (a run killed while exporting
+  // leaves it behind them; the next run brings it up to date).
+  std::map<std::string, std::map<std::string, workflow::OutputArtifact>> results;
+  for (const NodePlan& node : plan.nodes) {
+    if (node.state == workflow::NodeState::kCached && node.result) {
+      results[node.node->id] = node.result->outputs;
+    }
+  }
+  const std::vector<std::string> stale = workflow::stale_exports(study, results);
+  json["outputs_match"] = stale.empty();
+  json["stale_outputs"] = stale;
+  json["state"] = all_cached && !stale.empty()                    ? "outputs_stale"
+                  : all_cached                                    ? "done"
                   : plan.count(workflow::NodeState::kWaiting) > 0 ? "waiting"
                   : plan.count(workflow::NodeState::kFailed) > 0 ||
                           plan.count(workflow::NodeState::kInvalid) > 0
@@ -142,6 +155,9 @@ void print_status(const nlohmann::json& json, const std::string& dir) {
               << run["executed"] << " ran, " << run["cached"] << " cached, " << run["failed"]
               << " failed (" << run["started_at"].get<std::string>() << ", "
               << run["host"].get<std::string>() << ")\n";
+  }
+  for (const auto& stale : json["stale_outputs"]) {
+    std::cout << "outputs   " << stale.get<std::string>() << '\n';
   }
   const std::string state = json["state"];
   std::cout << "state     " << state;

@@ -11,11 +11,13 @@
 #include <vector>
 
 #include "app/commands/commands.h"
+#include "app/commands/operator_identity.h"
 #include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/file_bytes.h"
 #include "mmm_git_revision.h"
 #include "workflow/study/study.h"
+#include "worklists/audit_anchor.h"
 #include "worklists/audit_export.h"
 #include "worklists/audit_trail.h"
 #include "worklists/audit_verify.h"
@@ -35,11 +37,6 @@ fs::path root_of(const std::string& option) {
   if (!option.empty()) return option;
   const char* env = std::getenv("MMM_ROOT");
   return env != nullptr && *env != '\0' ? fs::path(env) : fs::path(".");
-}
-
-worklists::Actor actor_of(const fs::path& root, const std::string& name) {
-  worklists::check_registered_operator(root, name);
-  return {name, MMM_VERSION, worklists::is_supervisor(root, name)};
 }
 
 void print_table(const std::vector<worklists::WorklistEntry>& entries) {
@@ -107,7 +104,7 @@ void run_worklist(const WorklistArgs& args) {
 struct TaskArgs {
   std::string id;
   std::string root;
-  std::string operator_name;
+  OperatorCredentials credentials;
   std::string to;
   std::string file;
   std::vector<std::string> points;
@@ -265,7 +262,7 @@ void run_task_action(const std::string& action, const TaskArgs& args,
     }
     return;
   }
-  const worklists::Actor actor = actor_of(root, args.operator_name);
+  const worklists::Actor actor = command_line_actor(root, args.credentials);
   if (action == "claim") {
     worklists::claim_task(study, id, actor);
     std::cout << "task " << id << " claimed by " << actor.operator_name << '\n';
@@ -300,7 +297,7 @@ void run_task_action(const std::string& action, const TaskArgs& args,
     if (outcome.awaiting_review) {
       std::cout << "task " << id << (outcome.correction ? ": correction" : "")
                 << " submitted; it awaits review by a second operator "
-                << "('mmm task accept " << id << " --operator NAME')"
+                << "('mmm task accept " << id << "' under a second operator's token)"
                 << (outcome.correction ? "; the accepted values stay in force until then" : "")
                 << '\n';
       return;
@@ -311,12 +308,26 @@ void run_task_action(const std::string& action, const TaskArgs& args,
 }
 
 void run_audit(const std::string& action, const std::string& dir, const std::string& format,
-               const workflow::NodeRegistry& registry) {
+               const workflow::NodeRegistry& registry, const std::string& anchor_log = {}) {
   workflow::Study study = workflow::Study::open(dir, registry);
   worklists::prepare_audit_tables(study.database());
+  if (action == "anchor") {
+    const worklists::AuditAnchor anchor =
+        worklists::anchor_audit(study.database(), study.dir(), anchor_log);
+    std::cout << "anchored entry " << anchor.seq << " " << anchor.hash << " of " << anchor.study
+              << " in " << anchor_log << '\n';
+    return;
+  }
   if (action == "verify") {
-    const worklists::AuditVerification verification =
+    worklists::AuditVerification verification =
         worklists::verify_audit(study.database(), study.dir());
+    if (!anchor_log.empty()) {
+      for (worklists::AuditProblem& problem :
+           worklists::verify_anchors(study.database(), anchor_log)) {
+        verification.problems.push_back(std::move(problem));
+        verification.intact = false;
+      }
+    }
     for (const worklists::AuditProblem& problem : verification.problems) {
       (worklists::is_audit_warning(problem.kind) ? std::cout : std::cerr)
           << (worklists::is_audit_warning(problem.kind) ? "warning" : "TAMPERING") << " ["
@@ -370,13 +381,21 @@ void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registr
                               bool needs_operator) {
     auto args = std::make_shared<TaskArgs>();
     auto* command = task->add_subcommand(name, help);
-    command->add_option("ID", args->id, "Task id (or a unique prefix of 4+ characters)")
+    command
+        ->add_option("ID", args->id,
+                     "Task id (or a unique prefix of 4+ characters); STUDY/ID for one study's")
         ->required();
     command->add_option("--root", args->root,
                         "Folder holding the studies (default: $MMM_ROOT, else .)");
     if (needs_operator) {
-      command->add_option("--operator", args->operator_name, "Who acts (recorded in the audit)")
-          ->required();
+      command->add_option("--operator", args->credentials.operator_name,
+                          "Who acts: checked against the token (needed with --admin-override)");
+      command->add_option("--token-file", args->credentials.token_file,
+                          "File holding the operator's token (default: $MMM_OPERATOR_TOKEN, "
+                          "else the file named by $MMM_OPERATOR_TOKEN_FILE)");
+      command->add_option("--admin-override", args->credentials.override_reason,
+                          "Act as --operator without their token, for scripts of whoever may "
+                          "change the root's operators file; the reason goes into the audit");
     }
     command->callback([name, args, &registry] { run_task_action(name, *args, registry); });
     return std::pair{command, args};
@@ -426,7 +445,22 @@ void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registr
       "verify",
       "Check the hash chain and its checkpoint: edits, deletions, reordering, truncation");
   verify->add_option("DIR", *audit_dir, "Study folder")->required();
-  verify->callback([audit_dir, &registry] { run_audit("verify", *audit_dir, "", registry); });
+  auto anchor_log = std::make_shared<std::string>();
+  verify
+      ->add_option("--anchors", *anchor_log,
+                   "Also check the entries anchored in this log ('mmm audit anchor'): a trail "
+                   "rewritten end to end is found only this way")
+      ->check(CLI::ExistingFile);
+  verify->callback([audit_dir, anchor_log, &registry] {
+    run_audit("verify", *audit_dir, "", registry, *anchor_log);
+  });
+  auto* anchor = audit->add_subcommand(
+      "anchor", "Append the trail's head to a log kept outside the study (an external anchor)");
+  anchor->add_option("DIR", *audit_dir, "Study folder")->required();
+  anchor->add_option("--log", *anchor_log, "The anchor log (JSON lines, appended)")->required();
+  anchor->callback([audit_dir, anchor_log, &registry] {
+    run_audit("anchor", *audit_dir, "", registry, *anchor_log);
+  });
   auto* show = audit->add_subcommand("show", "Every entry (table, --json or --csv)");
   show->add_option("DIR", *audit_dir, "Study folder")->required();
   auto json_flag = std::make_shared<bool>(false);

@@ -10,7 +10,7 @@ namespace mmm::image::detail {
 
 namespace fs = std::filesystem;
 
-std::string read_file_bytes(const fs::path& path, std::string_view kind) {
+std::string read_file_bytes(const fs::path& path, std::string_view kind, std::uintmax_t max_bytes) {
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
   if (status.type() == fs::file_type::not_found) {
@@ -26,6 +26,11 @@ std::string read_file_bytes(const fs::path& path, std::string_view kind) {
   const std::uintmax_t size = fs::file_size(path, error);
   if (error) throw IoError(path, "cannot determine the file size: " + error.message());
   if (size == 0) throw IoError(path, "file is empty (0 bytes); was it written completely?");
+  if (size > max_bytes) {
+    throw IoError(path, "is " + std::to_string(size >> 20U) + " MiB, above the limit of " +
+                            std::to_string(max_bytes >> 20U) + " MiB for " + std::string(kind) +
+                            ": refused before reading (is it the right file?)");
+  }
   return mmm::read_file_bytes(path, size);
 }
 

@@ -4,16 +4,12 @@
 
 #include <algorithm>
 #include <array>
-#include <climits>
 #include <cstdlib>
-#include <cstring>
 #include <span>
-#include <sstream>
 #include <string_view>
 
 #include "core/errors.h"
 #include "core/file_bytes.h"
-#include "core/image/file_bytes.h"
 
 namespace mmm::image {
 
@@ -25,19 +21,10 @@ constexpr std::array<std::uint8_t, 8> kSignature = {137, 80, 78, 71, 13, 10, 26,
 // Largest IDAT written: libpng's default is 8 KiB; larger chunks cost nothing
 // and keep a radiograph's chunk list short.
 constexpr std::size_t kMaxIdatBytes = std::size_t{256} * 1024;
-// The PNG limit on chunk lengths and image dimensions (2^31 - 1).
-constexpr std::uint32_t kPngMaxValue = 0x7FFFFFFFU;
-// Largest filtered image data accepted when reading (2 GiB): far above any
-// radiograph (a 2000 x 6000 16-bit EOS image is 24 MB) and a guard against a
-// corrupt IHDR asking for terabytes.
-constexpr std::uint64_t kMaxImageBytes = std::uint64_t{1} << 31U;
 
 // PNG colour types.
 constexpr int kGray = 0;
 constexpr int kRgb = 2;
-constexpr int kPalette = 3;
-constexpr int kGrayAlpha = 4;
-constexpr int kRgba = 6;
 
 void append_u32(std::string& out, std::uint32_t value) {
   for (int shift = 24; shift >= 0; shift -= 8) {
@@ -45,19 +32,8 @@ void append_u32(std::string& out, std::uint32_t value) {
   }
 }
 
-std::uint32_t load_u32(const std::uint8_t* bytes) {
-  return (std::uint32_t{bytes[0]} << 24U) | (std::uint32_t{bytes[1]} << 16U) |
-         (std::uint32_t{bytes[2]} << 8U) | std::uint32_t{bytes[3]};
-}
-
 std::uint32_t crc_of(const std::uint8_t* bytes, std::size_t size) {
   return static_cast<std::uint32_t>(crc32_z(crc32_z(0, nullptr, 0), bytes, size));
-}
-
-std::string hex32(std::uint32_t value) {
-  std::ostringstream out;
-  out << "0x" << std::hex << value;
-  return out.str();
 }
 
 // Appends length, type, data and the CRC-32 of type + data.
@@ -240,158 +216,6 @@ std::string encode_png(const ImageT& image, int colour_type, const PngWriteOptio
   return out;
 }
 
-std::string describe_format(int colour_type, int bit_depth) {
-  std::string kind;
-  switch (colour_type) {
-    case kGray:
-      kind = "grayscale";
-      break;
-    case kRgb:
-      kind = "RGB";
-      break;
-    case kPalette:
-      kind = "palette (indexed colour)";
-      break;
-    case kGrayAlpha:
-      kind = "grayscale + alpha";
-      break;
-    case kRgba:
-      kind = "RGBA";
-      break;
-    default:
-      kind = "colour type " + std::to_string(colour_type);
-  }
-  return std::to_string(bit_depth) + "-bit " + kind;
-}
-
-struct Header {
-  int width = 0;
-  int height = 0;
-  int bit_depth = 0;
-  int colour_type = 0;
-};
-
-Header parse_header(const fs::path& path, const std::uint8_t* data, std::uint32_t length) {
-  if (length != 13) {
-    throw IoError(path, "IHDR chunk has " + std::to_string(length) +
-                            " data bytes, expected 13 (corrupt file)");
-  }
-  const std::uint32_t width = load_u32(data);
-  const std::uint32_t height = load_u32(data + 4);
-  if (width == 0 || height == 0 || width > kPngMaxValue || height > kPngMaxValue) {
-    throw IoError(path, "IHDR gives an invalid image size " + std::to_string(width) + " x " +
-                            std::to_string(height) + " (each must be in [1, 2^31 - 1])");
-  }
-  Header header{static_cast<int>(width), static_cast<int>(height), data[8], data[9]};
-  if (data[10] != 0 || data[11] != 0) {
-    throw IoError(path, "IHDR names compression method " + std::to_string(data[10]) +
-                            " and filter method " + std::to_string(data[11]) +
-                            "; PNG defines only method 0 for both (corrupt file)");
-  }
-  if (data[12] == 1) {
-    throw IoError(path,
-                  "Adam7-interlaced PNGs are not supported; re-save the image without "
-                  "interlacing (e.g. `convert in.png -interlace none out.png`)");
-  }
-  if (data[12] != 0) {
-    throw IoError(path, "IHDR names interlace method " + std::to_string(data[12]) +
-                            "; PNG defines only 0 and 1 (corrupt file)");
-  }
-  const int depth = header.bit_depth;
-  const int type = header.colour_type;
-  const bool supported = (type == kGray && (depth == 8 || depth == 16)) ||
-                         ((type == kRgb || type == kRgba) && depth == 8);
-  if (!supported) {
-    throw IoError(path, "holds " + describe_format(type, depth) +
-                            " samples; supported are 8- or 16-bit grayscale, 8-bit RGB and "
-                            "8-bit RGBA (convert it, e.g. `convert in.png -depth 8 "
-                            "-type TrueColor out.png`)");
-  }
-  return header;
-}
-
-// Inflates the concatenated IDAT data into exactly `expected` bytes (at most
-// kMaxImageBytes, so zlib's 32-bit counters hold it) in one Z_FINISH call.
-std::vector<std::uint8_t> inflate_exactly(const fs::path& path, const std::string& zdata,
-                                          std::size_t expected) {
-  if (zdata.size() > UINT_MAX) {
-    throw IoError(path, "the IDAT chunks hold more than 4 GiB of compressed data (corrupt file)");
-  }
-  std::vector<std::uint8_t> out(expected);
-  z_stream stream{};
-  if (inflateInit(&stream) != Z_OK) throw IoError(path, "zlib could not start (out of memory?)");
-  // zlib's next_in is not const-qualified but inflate never writes through it.
-  stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(zdata.data()));
-  stream.avail_in = static_cast<uInt>(zdata.size());
-  stream.next_out = out.data();
-  stream.avail_out = static_cast<uInt>(expected);
-  const int status = inflate(&stream, Z_FINISH);
-  const std::string message = stream.msg != nullptr ? stream.msg : "no message";
-  const std::size_t produced = expected - stream.avail_out;
-  const bool output_full = stream.avail_out == 0;
-  inflateEnd(&stream);
-  if (status == Z_STREAM_END && output_full) return out;
-  const std::string progress =
-      std::to_string(produced) + " of the " + std::to_string(expected) + " bytes";
-  switch (status) {
-    case Z_STREAM_END:
-      throw IoError(path, "image data too short: the zlib stream ends after " + progress +
-                              " the IHDR size needs (rows are missing)");
-    case Z_MEM_ERROR:
-      throw IoError(path, "out of memory while inflating the image data");
-    case Z_OK:
-    case Z_BUF_ERROR:
-      if (output_full) {
-        throw IoError(path, "image data is longer than the IHDR size allows (" +
-                                std::to_string(expected) + " bytes); the file is corrupt");
-      }
-      throw IoError(path, "truncated image data: the zlib stream stops after " + progress +
-                              " (was the file cut short?)");
-    default:
-      throw IoError(path,
-                    "image data is corrupt: zlib reports '" + message + "' after " + progress);
-  }
-}
-
-// Undoes the row filters: `data` holds height rows of 1 + row_bytes
-// bytes; returns the unfiltered rows without their filter bytes.
-std::vector<std::uint8_t> unfilter(const fs::path& path, const std::vector<std::uint8_t>& data,
-                                   std::size_t height, std::size_t row_bytes, std::size_t bpp) {
-  std::vector<std::uint8_t> rows(height * row_bytes);
-  const std::vector<std::uint8_t> zero_row(row_bytes, 0);
-  for (std::size_t y = 0; y < height; ++y) {
-    const std::uint8_t* in = data.data() + y * (row_bytes + 1);
-    const std::uint8_t type = in[0];
-    ++in;
-    std::uint8_t* row = rows.data() + y * row_bytes;
-    const std::uint8_t* prior = y == 0 ? zero_row.data() : row - row_bytes;
-    if (type > 4) {
-      throw IoError(path, "row " + std::to_string(y) + " has filter type " + std::to_string(type) +
-                              "; PNG defines 0 to 4 (corrupt file)");
-    }
-    const auto filter = static_cast<PngFilter>(type);
-    for (std::size_t i = 0; i < row_bytes; ++i) {
-      const int a = i >= bpp ? row[i - bpp] : 0;
-      const int c = i >= bpp ? prior[i - bpp] : 0;
-      row[i] = static_cast<std::uint8_t>(in[i] + predict(filter, a, prior[i], c));
-    }
-  }
-  return rows;
-}
-
-template <typename ImageT>
-ImageT to_image(const Header& header, const std::vector<std::uint8_t>& rows) {
-  ImageT image(header.width, header.height);
-  if constexpr (sizeof(typename ImageT::Sample) == 1) {
-    std::copy(rows.begin(), rows.end(), image.pixels.begin());
-  } else {
-    for (std::size_t i = 0; i < image.pixels.size(); ++i) {
-      image.pixels[i] = static_cast<std::uint16_t>((rows[2 * i] << 8U) | rows[2 * i + 1]);
-    }
-  }
-  return image;
-}
-
 }  // namespace
 
 void write_png(const GrayImage8& image, const fs::path& path, const PngWriteOptions& options) {
@@ -404,131 +228,6 @@ void write_png(const GrayImage16& image, const fs::path& path, const PngWriteOpt
 
 void write_png(const RgbImage8& image, const fs::path& path, const PngWriteOptions& options) {
   write_file_atomically(path, encode_png(image, kRgb, options));
-}
-
-PngContent decode_png(const fs::path& path, const std::string& file) {
-  const auto* bytes = reinterpret_cast<const std::uint8_t*>(file.data());
-  const std::size_t size = file.size();
-  if (size < kSignature.size() || !std::equal(kSignature.begin(), kSignature.end(), bytes)) {
-    if (size >= 4 && std::memcmp(file.data() + 1, "PNG", 3) == 0) {
-      throw IoError(path,
-                    "PNG signature damaged (line endings converted? the file was probably "
-                    "transferred in text mode)");
-    }
-    throw IoError(path, "not a PNG file (the 8-byte PNG signature is missing)");
-  }
-  PngContent content;
-  Header header;
-  bool have_header = false;
-  bool have_end = false;
-  std::string zdata;
-  std::size_t pos = kSignature.size();
-  while (!have_end) {
-    if (pos == size) {
-      throw IoError(path, "truncated: the file ends after " + std::to_string(size) +
-                              " bytes without an IEND chunk");
-    }
-    if (size - pos < 8) {
-      throw IoError(
-          path, "truncated: the file ends inside a chunk header at byte " + std::to_string(pos));
-    }
-    const std::uint32_t length = load_u32(bytes + pos);
-    const std::string type(file.data() + pos + 4, 4);
-    const std::string where = "chunk '" + type + "' at byte " + std::to_string(pos);
-    for (const char c : type) {
-      if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'))) {
-        throw IoError(path, "chunk at byte " + std::to_string(pos) +
-                                " has an invalid type (not 4 letters): the file is corrupt");
-      }
-    }
-    if (length > kPngMaxValue) {
-      throw IoError(path, where + " declares " + std::to_string(length) +
-                              " data bytes, above the PNG limit 2^31 - 1 (corrupt file)");
-    }
-    if (size - pos - 8 < std::size_t{length} + 4) {
-      throw IoError(path, "truncated: " + where + " declares " + std::to_string(length) +
-                              " data bytes + 4 CRC bytes, but only " +
-                              std::to_string(size - pos - 8) + " bytes remain");
-    }
-    const std::uint8_t* data = bytes + pos + 8;
-    const std::uint32_t stored_crc = load_u32(data + length);
-    const std::uint32_t computed_crc = crc_of(bytes + pos + 4, std::size_t{length} + 4);
-    if (stored_crc != computed_crc) {
-      throw IoError(path, where + ": CRC mismatch (stored " + hex32(stored_crc) + ", computed " +
-                              hex32(computed_crc) + "): the file is corrupt");
-    }
-    if (!have_header && type != "IHDR") {
-      throw IoError(path, "the first chunk is '" + type + "', expected IHDR (corrupt file)");
-    }
-    if (type == "IHDR") {
-      if (have_header) throw IoError(path, where + ": a second IHDR (corrupt file)");
-      header = parse_header(path, data, length);
-      have_header = true;
-    } else if (type == "IDAT") {
-      zdata.append(reinterpret_cast<const char*>(data), length);
-    } else if (type == "IEND") {
-      have_end = true;
-    } else if (type == "tEXt") {
-      const std::string_view chunk(reinterpret_cast<const char*>(data), length);
-      const std::size_t nul = chunk.find('\0');
-      if (nul == std::string_view::npos) {
-        throw IoError(path, where + ": tEXt without the NUL byte ending its keyword");
-      }
-      content.text.push_back(
-          {std::string(chunk.substr(0, nul)), std::string(chunk.substr(nul + 1))});
-    } else if (type == "PLTE") {
-      // A suggested palette for truecolour images: nothing to apply.
-    } else if ((static_cast<unsigned char>(type[0]) & 0x20U) == 0) {
-      throw IoError(path, where + ": unknown critical chunk; this reader cannot decode the image");
-    }
-    pos += std::size_t{length} + 12;
-  }
-  if (zdata.empty()) throw IoError(path, "no IDAT chunk: the file holds no image data");
-
-  const std::size_t channels = header.colour_type == kGray ? 1 : header.colour_type == kRgb ? 3 : 4;
-  const std::size_t bpp = channels * static_cast<std::size_t>(header.bit_depth / 8);
-  const std::uint64_t row_bytes = std::uint64_t{bpp} * static_cast<std::uint64_t>(header.width);
-  const std::uint64_t total = (row_bytes + 1) * static_cast<std::uint64_t>(header.height);
-  if (total > kMaxImageBytes) {
-    throw IoError(path, "image of " + std::to_string(header.width) + " x " +
-                            std::to_string(header.height) + " " +
-                            describe_format(header.colour_type, header.bit_depth) +
-                            " pixels is too large for this reader (limit 2 GiB of row data)");
-  }
-  const std::vector<std::uint8_t> filtered =
-      inflate_exactly(path, zdata, static_cast<std::size_t>(total));
-  const std::vector<std::uint8_t> rows =
-      unfilter(path, filtered, static_cast<std::size_t>(header.height),
-               static_cast<std::size_t>(row_bytes), bpp);
-  if (header.colour_type == kGray && header.bit_depth == 8) {
-    content.image = to_image<GrayImage8>(header, rows);
-  } else if (header.colour_type == kGray) {
-    content.image = to_image<GrayImage16>(header, rows);
-  } else if (header.colour_type == kRgb) {
-    content.image = to_image<RgbImage8>(header, rows);
-  } else {
-    content.image = to_image<RgbaImage8>(header, rows);
-  }
-  return content;
-}
-
-PngContent read_png(const fs::path& path) {
-  return decode_png(path, detail::read_file_bytes(path, "a PNG file"));
-}
-
-GrayImage16 read_png_gray16(const fs::path& path) {
-  PngContent content = read_png(path);
-  if (auto* gray16 = std::get_if<GrayImage16>(&content.image)) return std::move(*gray16);
-  if (const auto* gray8 = std::get_if<GrayImage8>(&content.image)) {
-    GrayImage16 wide(gray8->width, gray8->height);
-    for (std::size_t i = 0; i < wide.pixels.size(); ++i) {
-      wide.pixels[i] = static_cast<std::uint16_t>(gray8->pixels[i] * 257U);
-    }
-    return wide;
-  }
-  const bool rgb = std::holds_alternative<RgbImage8>(content.image);
-  throw IoError(path, std::string("holds 8-bit ") + (rgb ? "RGB" : "RGBA") +
-                          ", expected a grayscale radiograph (convert it to grayscale first)");
 }
 
 }  // namespace mmm::image

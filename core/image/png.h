@@ -11,10 +11,9 @@
 //   write: rows -> filter each row (all five filters available; by default
 //          the one with the least sum of |signed bytes|, the libpng heuristic)
 //          -> zlib deflate -> IDAT chunks of <= 256 KiB
-//   read:  every chunk's CRC checked -> IDATs inflated -> rows unfiltered
-//          (None, Sub, Up, Average, Paeth) -> samples (16-bit ones are
-//          big-endian in the file, native in memory).
-// Compression and CRC-32 come from zlib.
+//   read:  libspng (a decoder written for untrusted files and fuzzed
+//          continuously upstream), with the size limits below applied to the
+//          file and to the header's dimensions before anything is decoded.
 
 #include <cstdint>
 #include <filesystem>
@@ -26,6 +25,15 @@
 #include "core/image/image.h"
 
 namespace mmm::image {
+
+// Reading limits. A file above kPngMaxFileBytes is refused before it is read;
+// a header asking for more than kPngMaxSide pixels on a side, or for more than
+// kPngMaxDecodedBytes of samples, is refused before the image data is
+// inflated (a few hundred compressed bytes can claim gigabytes). An EOS
+// full-body image, ~2,000 x 9,000 16-bit pixels, is 34 MiB decoded.
+inline constexpr std::uintmax_t kPngMaxFileBytes = std::uintmax_t{256} << 20U;
+inline constexpr std::uint32_t kPngMaxSide = 65'535;
+inline constexpr std::uint64_t kPngMaxDecodedBytes = std::uint64_t{512} << 20U;
 
 // A tEXt chunk: keyword (1-79 printable Latin-1 characters, no leading,
 // trailing or doubled spaces) and text (any bytes but NUL; Latin-1 by the
@@ -77,12 +85,12 @@ struct PngContent {
 // any number of IDAT chunks. Ancillary chunks other than tEXt are skipped
 // (their CRC is still checked); gamma, colour profiles and transparency keys
 // are not applied. Throws IoError naming the path and the problem: missing or
-// empty file, bad signature, a chunk whose CRC does not match ("chunk 'IDAT'
-// at byte 41: CRC mismatch ..."), truncation (a chunk running past the end of
-// the file, no IEND, a zlib stream that ends early), a corrupt zlib stream, an
-// invalid filter byte, an unknown critical chunk, or a format outside the list
-// above (palette, gray+alpha, bit depths 1/2/4, 16-bit colour, interlacing),
-// the latter with a hint to convert the file.
+// empty file, a file or image above the limits above, bad signature, a chunk
+// whose CRC does not match, truncation (no IEND, a zlib stream that ends
+// early), a corrupt zlib stream, an invalid filter byte, an unknown critical
+// chunk, or a format outside the list above (palette, gray+alpha, bit depths
+// 1/2/4, 16-bit colour, interlacing), the latter with a hint to convert the
+// file.
 PngContent read_png(const std::filesystem::path& path);
 
 // The same from a PNG file's bytes already in memory (e.g. an image held in

@@ -23,6 +23,9 @@ using Matrix34d = Eigen::Matrix<double, 3, 4>;
 
 namespace {
 
+// A view sidecar is a few kilobytes; anything past this is not one.
+constexpr std::uintmax_t kMaxSidecarBytes = std::uintmax_t{1} << 20U;
+
 constexpr const char* kSidecarFormat = "mmm-radiograph-views";
 constexpr int kSidecarVersion = 1;
 // Largest image side make_biplanar_views accepts (pixels): 30 m at 0.3 mm.
@@ -229,7 +232,7 @@ class SidecarReader {
   }
 
   std::vector<RadiographFile> read() const {
-    return parse(detail::read_file_bytes(path_, "a view sidecar (JSON)"));
+    return parse(detail::read_file_bytes(path_, "a view sidecar (JSON)", kMaxSidecarBytes));
   }
 
   std::vector<RadiographFile> parse(const std::string& text) const {

@@ -85,7 +85,8 @@ RadiographPair load_radiograph_pair(const fs::path& sidecar) {
   pair.views = read_view_sidecar(sidecar);
   const fs::path folder = sidecar.parent_path();
   for (const RadiographFile& file : pair.views) {
-    std::string png = detail::read_file_bytes(folder / file.image, "a radiograph (PNG)");
+    std::string png =
+        detail::read_file_bytes(folder / file.image, "a radiograph (PNG)", kPngMaxFileBytes);
     check_image(file, png, folder);
     pair.images.emplace(file.image, std::move(png));
   }

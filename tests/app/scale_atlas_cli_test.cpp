@@ -11,6 +11,7 @@
 #include "core/atlas/atlas_io.h"
 #include "core/image/png.h"
 #include "core/image/projection.h"
+#include "tests/app/operator_token.h"
 #include "tests/support/test_data.h"
 #include "tests/support/toy_leg_atlas.h"
 
@@ -57,7 +58,8 @@ TEST(ScaleAtlasCliTest, TheStationsLandmarksScaleTheAtlasAndItIsExported) {
   ASSERT_EQ(tasks.size(), 1U) << listed.out;
   const std::string id = tasks[0]["task"].get<std::string>();
   const std::string where = " --root " + root.string();
-  ASSERT_EQ(run_mmm("task claim " + id + where + " --operator ana").exit_code, 0);
+  const std::string ana = mmm::test::operator_token_option(root, "ana", dir.path());
+  ASSERT_EQ(run_mmm("task claim " + id + where + ana).exit_code, 0);
   // The patient: the atlas 5 % larger about the hip.
   const Eigen::Vector3d hip(80, 0, -50);
   std::string points;
@@ -70,7 +72,7 @@ TEST(ScaleAtlasCliTest, TheStationsLandmarksScaleTheAtlasAndItIsExported) {
                 "," + std::to_string(uv.y());
     }
   }
-  const CommandResult accepted = run_mmm("task submit " + id + where + " --operator ana" + points);
+  const CommandResult accepted = run_mmm("task submit " + id + where + ana + points);
   ASSERT_EQ(accepted.exit_code, 0) << accepted.out << accepted.err;
 
   const fs::path outputs = study / "outputs";

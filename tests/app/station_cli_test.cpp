@@ -11,6 +11,7 @@
 
 #include "core/image/png.h"
 #include "core/image/projection.h"
+#include "tests/app/operator_token.h"
 #include "tests/support/test_data.h"
 
 namespace mmm {
@@ -42,6 +43,8 @@ class StationCliTest : public ::testing::Test {
                 " --input frontal=" + (dir_ / "frontal.png").string() +
                 " --input lateral=" + (dir_ / "lateral.png").string() + " --input patient=P042");
     ASSERT_EQ(created.exit_code, 0) << created.err;
+    ana_ = mmm::test::operator_token_option(root_, "ana", dir_.path());
+    ben_ = mmm::test::operator_token_option(root_, "ben", dir_.path());
   }
 
   std::string point(const std::string& name, const Eigen::Vector3d& X) const {
@@ -66,6 +69,8 @@ class StationCliTest : public ::testing::Test {
   fs::path root_ = dir_ / "studies";
   fs::path study_ = root_ / "p42";
   std::vector<image::RadiographView> views_;
+  std::string ana_;  // " --token-file FILE" of operator ana
+  std::string ben_;
 };
 
 TEST_F(StationCliTest, PauseSubmitRejectedThenAcceptedResumesAndTheAuditVerifies) {
@@ -78,24 +83,24 @@ TEST_F(StationCliTest, PauseSubmitRejectedThenAcceptedResumesAndTheAuditVerifies
   EXPECT_NE(table.out.find("open"), std::string::npos) << table.out;
 
   const std::string task = " --root " + root_.string();
-  const CommandResult claimed = run_mmm("task claim " + id.substr(0, 5) + task + " --operator ana");
+  const CommandResult claimed = run_mmm("task claim " + id.substr(0, 5) + task + ana_);
   EXPECT_EQ(claimed.exit_code, 0) << claimed.err;
-  EXPECT_EQ(run_mmm("task claim " + id + task + " --operator ben").exit_code, 1);
+  EXPECT_EQ(run_mmm("task claim " + id + task + ben_).exit_code, 1);
 
   const Eigen::Vector3d head(90, 0, 900);
   const Eigen::Vector3d patella(80, 30, 480);
   // The patella placed above the femoral head: rejected, with the reason.
   const CommandResult rejected =
-      run_mmm("task submit " + id + task + " --operator ana" +
-              point("femoral_head_centre_r", patella) + point("patella_centre_r", head));
+      run_mmm("task submit " + id + task + ana_ + point("femoral_head_centre_r", patella) +
+              point("patella_centre_r", head));
   EXPECT_EQ(rejected.exit_code, 1);
   EXPECT_NE(rejected.err.find("rejected"), std::string::npos) << rejected.err;
   EXPECT_NE(rejected.err.find("above"), std::string::npos) << rejected.err;
 
-  ASSERT_EQ(run_mmm("task claim " + id + task + " --operator ana").exit_code, 0);
+  ASSERT_EQ(run_mmm("task claim " + id + task + ana_).exit_code, 0);
   const CommandResult accepted =
-      run_mmm("task submit " + id + task + " --operator ana" +
-              point("femoral_head_centre_r", head) + point("patella_centre_r", patella));
+      run_mmm("task submit " + id + task + ana_ + point("femoral_head_centre_r", head) +
+              point("patella_centre_r", patella));
   EXPECT_EQ(accepted.exit_code, 0) << accepted.out << accepted.err;
   EXPECT_NE(accepted.out.find("study resumed"), std::string::npos) << accepted.out;
   const Json report = Json::parse(test::read_text(study_ / "outputs/landmark_report.json"));
@@ -127,7 +132,7 @@ TEST_F(StationCliTest, PauseSubmitRejectedThenAcceptedResumesAndTheAuditVerifies
 TEST_F(StationCliTest, DeepOrHugeSubmissionFilesAreRefusedAndTheTaskStaysOpen) {
   ASSERT_EQ(run_mmm("run " + study_.string() + " -q").exit_code, 3);
   const std::string id = task_id();
-  const std::string task = " --root " + root_.string() + " --operator ana";
+  const std::string task = " --root " + root_.string() + ana_;
   ASSERT_EQ(run_mmm("task claim " + id + task).exit_code, 0);
 
   const fs::path deep =
@@ -148,6 +153,53 @@ TEST_F(StationCliTest, DeepOrHugeSubmissionFilesAreRefusedAndTheTaskStaysOpen) {
   EXPECT_EQ(accepted.exit_code, 0) << accepted.out << accepted.err;
 }
 
+// On the command line an operator acts under their own token (a file or the
+// environment, never an argument); an administrative override is named,
+// needs a reason and is recorded in the audit trail.
+TEST_F(StationCliTest, CommandLineActionsNeedTheOperatorsTokenOrAnAuditedOverride) {
+  ASSERT_EQ(run_mmm("run " + study_.string() + " -q").exit_code, 3);
+  const std::string id = task_id();
+  const std::string task = " --root " + root_.string();
+
+  const CommandResult bare = run_mmm("task claim " + id + task + " --operator ana");
+  EXPECT_EQ(bare.exit_code, 1);
+  EXPECT_NE(bare.err.find("no operator token"), std::string::npos) << bare.err;
+  const CommandResult other = run_mmm("task claim " + id + task + ben_ + " --operator ana");
+  EXPECT_EQ(other.exit_code, 1);
+  EXPECT_NE(other.err.find("the token is operator 'ben''s, not 'ana''s"), std::string::npos)
+      << other.err;
+  const CommandResult forged = run_mmm("task claim " + id + task, "MMM_OPERATOR_TOKEN=forged");
+  EXPECT_EQ(forged.exit_code, 1);
+  EXPECT_NE(forged.err.find("unknown operator token"), std::string::npos) << forged.err;
+  const CommandResult blank =
+      run_mmm("task claim " + id + task + " --operator ana --admin-override '  '");
+  EXPECT_EQ(blank.exit_code, 1);
+  EXPECT_NE(blank.err.find("needs a reason"), std::string::npos) << blank.err;
+
+  // The token from the environment.
+  const std::string ana_token = test::read_text(dir_ / "ana.token");
+  const CommandResult claimed = run_mmm(
+      "task claim " + id + task, "MMM_OPERATOR_TOKEN=" + ana_token.substr(0, ana_token.find('\n')));
+  EXPECT_EQ(claimed.exit_code, 0) << claimed.err;
+  EXPECT_NE(claimed.out.find("claimed by ana"), std::string::npos) << claimed.out;
+
+  // A script of the root's administrator releases it for ana, by override.
+  const CommandResult released =
+      run_mmm("task release " + id + task + " --operator ana --admin-override 'nightly cleanup'");
+  EXPECT_EQ(released.exit_code, 0) << released.err;
+  const Json trail = Json::parse(run_mmm("audit show " + study_.string() + " --json").out);
+  ASSERT_GE(trail.size(), 2U);
+  const Json& override_entry = trail[trail.size() - 2];
+  EXPECT_EQ(override_entry["action"], "override");
+  EXPECT_EQ(override_entry["operator"], "ana");
+  EXPECT_NE(override_entry["reason"].get<std::string>().find(
+                "administrative override for 'release': nightly cleanup"),
+            std::string::npos)
+      << override_entry;
+  EXPECT_EQ(trail.back()["action"], "release");
+  EXPECT_EQ(run_mmm("audit verify " + study_.string()).exit_code, 0);
+}
+
 // mmm report on a study that has only its landmarks: the audit section names
 // who submitted which landmarks, the later sections say they are not computed
 // yet, and the page is offline (no scripts, no links out).
@@ -155,10 +207,10 @@ TEST_F(StationCliTest, ReportShowsTheAuditAndWhatIsNotComputedYet) {
   EXPECT_EQ(run_mmm("run " + study_.string() + " -q").exit_code, 3);
   const std::string id = task_id();
   const std::string task = " --root " + root_.string();
-  ASSERT_EQ(run_mmm("task claim " + id + task + " --operator ana").exit_code, 0);
-  const CommandResult accepted = run_mmm("task submit " + id + task + " --operator ana" +
-                                         point("femoral_head_centre_r", {90, 0, 900}) +
-                                         point("patella_centre_r", {80, 30, 480}));
+  ASSERT_EQ(run_mmm("task claim " + id + task + ana_).exit_code, 0);
+  const CommandResult accepted =
+      run_mmm("task submit " + id + task + ana_ + point("femoral_head_centre_r", {90, 0, 900}) +
+              point("patella_centre_r", {80, 30, 480}));
   ASSERT_EQ(accepted.exit_code, 0) << accepted.err;
 
   const CommandResult reported = run_mmm("report " + study_.string());

@@ -172,8 +172,9 @@ def correct_patella(args, demo):
     before = execution_ids(status(args, study))
     reason = "patella centre placed on the upper pole; moved to the centre"
     submitted = subprocess.run(
-        [str(args.mmm), "task", "submit", tasks[0]["task"], "--root", str(root), "--operator",
-         "scripted-operator", "--file", str(corrected), "--reason", reason, "-j", "2"],
+        [str(args.mmm), "task", "submit", tasks[0]["task"], "--root", str(root), "--token-file",
+         str(demo / "scripted-operator.token"), "--file", str(corrected), "--reason", reason,
+         "-j", "2"],
         capture_output=True, text=True)
     if submitted.returncode != 0:
         fail("the correction was refused: " + submitted.stdout + submitted.stderr)

@@ -425,6 +425,29 @@ TEST_F(TaskActionsTest, OnlyTheAssigneeOrASupervisorReleasesReassignsOrCancelsAC
   EXPECT_EQ(find_task(study.database(), id)->state, TaskState::kOpen);
 }
 
+// A copied study folder keeps its task ids: a full id then names two tasks,
+// and no command may pick one of them silently.
+TEST_F(TaskActionsTest, AnIdInTwoStudiesIsRefusedNamingThemAndStudySlashIdPicksOne) {
+  Study study = open();
+  const std::string id = pause(study);
+  ASSERT_FALSE(id.empty());
+  fs::copy(dir_, root_ / "copy", fs::copy_options::recursive);
+  try {
+    (void)locate_task(root_.path(), id);
+    FAIL() << "an id in two studies was resolved";
+  } catch (const InvalidInputError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("several studies"), std::string::npos) << what;
+    EXPECT_NE(what.find("(study)"), std::string::npos) << what;
+    EXPECT_NE(what.find("(copy)"), std::string::npos) << what;
+    EXPECT_NE(what.find("STUDY/" + id), std::string::npos) << what;
+  }
+  EXPECT_THROW((void)locate_task(root_.path(), id.substr(0, 6)), InvalidInputError);
+  EXPECT_EQ(locate_task(root_.path(), "copy/" + id).study, "copy");
+  EXPECT_EQ(locate_task(root_.path(), "study/" + id.substr(0, 6)).study, "study");
+  EXPECT_THROW((void)locate_task(root_.path(), "elsewhere/" + id), InvalidInputError);
+}
+
 TEST_F(TaskActionsTest, ReservedNamesCannotAct) {
   Study study = open();
   const std::string id = pause(study);

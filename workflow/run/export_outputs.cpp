@@ -77,6 +77,14 @@ std::string read_all(const std::filesystem::path& file) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+// Whether two files hold the same bytes (sizes first).
+bool same_content(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code error;
+  const std::uintmax_t size = std::filesystem::file_size(a, error);
+  if (error || size != std::filesystem::file_size(b, error) || error) return false;
+  return read_all(a) == read_all(b);
+}
+
 // Whether the first line is a CSV header: names separated by at least one
 // comma, nothing that would make it markup or binary.
 bool csv_header(const std::string& head) {
@@ -165,7 +173,7 @@ ExportReport export_outputs(
     const bool atlas = artifact->type == PortType::kAtlas || file.ends_with(".bundle");
     if (previous != recorded.end() && previous->second.hash == artifact->hash &&
         previous->second.file == file && std::filesystem::is_regular_file(target, error) &&
-        std::filesystem::file_size(target, error) == std::filesystem::file_size(blob, error) &&
+        same_content(target, blob) &&
         (!atlas || std::filesystem::is_directory(folder / output.name, error))) {
       continue;  // already current
     }
@@ -187,6 +195,48 @@ ExportReport export_outputs(
     report.written.push_back(output.name);
   }
   return report;
+}
+
+std::vector<std::string> stale_exports(
+    Study& study, const std::map<std::string, std::map<std::string, OutputArtifact>>& results) {
+  std::vector<std::string> stale;
+  const std::filesystem::path folder = study.outputs_dir();
+  const std::map<std::string, RecordedExport> recorded = recorded_exports(study.database());
+  for (const WorkflowOutput& output : study.workflow().outputs) {
+    const OutputArtifact* artifact = nullptr;
+    if (const auto node = results.find(output.source.node); node != results.end()) {
+      if (const auto port = node->second.find(output.source.port); port != node->second.end()) {
+        artifact = &port->second;
+      }
+    }
+    const auto previous = recorded.find(output.name);
+    const std::string name = "'" + output.name + "': ";
+    if (artifact == nullptr) {
+      if (previous != recorded.end()) {
+        stale.push_back(name + "outputs/" + previous->second.file +
+                        " is left from an earlier result (the node has no current one)");
+      }
+      continue;
+    }
+    if (previous == recorded.end()) {
+      stale.push_back(name + "the result is not exported yet");
+      continue;
+    }
+    const std::filesystem::path target = folder / previous->second.file;
+    if (previous->second.hash != artifact->hash) {
+      stale.push_back(name + "outputs/" + previous->second.file + " holds an earlier result");
+      continue;
+    }
+    std::error_code error;
+    const std::filesystem::path blob = study.artifacts().path_of(artifact->hash);
+    if (!std::filesystem::is_regular_file(target, error)) {
+      stale.push_back(name + "outputs/" + previous->second.file + " is missing");
+    } else if (!same_content(target, blob)) {
+      stale.push_back(name + "outputs/" + previous->second.file +
+                      " was changed after it was exported");
+    }
+  }
+  return stale;
 }
 
 }  // namespace mmm::workflow

@@ -26,6 +26,15 @@ struct ExportReport {
 ExportReport export_outputs(
     Study& study, const std::map<std::string, std::map<std::string, OutputArtifact>>& available);
 
+// What in outputs/ does not match the study's current results, one sentence
+// per export ("'total': outputs/total.json holds an earlier result"): a file
+// that is missing, changed or left from an earlier result, or a result not
+// exported yet (a run killed while exporting). `results`: node -> port ->
+// artifact, the current results (as plan_study finds them). Empty: outputs/
+// matches the results. Reads only.
+std::vector<std::string> stale_exports(
+    Study& study, const std::map<std::string, std::map<std::string, OutputArtifact>>& results);
+
 // The file name of an export: name + the extension of its port type; for an
 // opaque File, the extension its content shows (.png, .svg, .pdf, .trc,
 // .mot, .osim, .csv, .bundle for a folder bundle; none otherwise) when

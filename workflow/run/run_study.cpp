@@ -431,11 +431,34 @@ class Scheduler {
     if (observer() != nullptr) observer()->node_finished(node.id, false, 0, error);
   }
 
+  // A node's error names the files it read by their place in the store
+  // (artifacts/ab/cdef...); the person running the study knows the file they
+  // gave: name it, with the input's name.
+  [[nodiscard]] std::string naming_user_files(std::string error) const {
+    for (const auto& [name, input] : inputs_) {
+      if (!input.is_file || input.hash.empty()) continue;
+      const std::string user_file = "'" + input.given + "' (study input '" + name + "')";
+      for (const std::string& stored :
+           {study_.artifacts().path_of(input.hash).string(),
+            ArtifactStore::relative_path_of(input.hash).generic_string()}) {
+        for (std::size_t at = error.find(stored); at != std::string::npos;
+             at = error.find(stored, at + user_file.size())) {
+          error.replace(at, stored.size(), user_file);
+        }
+      }
+    }
+    return error;
+  }
+
   void finish(Completion& completion) {
     --running_;
     ExecutionRecord& record = running_records_.at(completion.node);
     record.finished_at = utc_now_precise();
     record.seconds = completion.seconds;
+    if (!completion.error.empty()) {
+      completion.error = naming_user_files(completion.error);
+      if (!completion.logs.empty()) completion.logs.back().message = completion.error;
+    }
     record.error = completion.error;
     record.outputs = completion.outputs;
     record.status = completion.error.empty() ? ExecutionStatus::kDone : ExecutionStatus::kFailed;

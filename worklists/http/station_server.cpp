@@ -20,7 +20,7 @@
 
 // Last: httplib.h includes <resolv.h>, whose macro `_res` would rename
 // parameters of Eigen's headers (included above through core/).
-#include <httplib.h>
+#include "worklists/http/guarded_server.h"
 
 namespace mmm::worklists::http {
 namespace {
@@ -165,14 +165,14 @@ class PixelCache {
 struct StationServer::Impl {
   ServerOptions options;
   const workflow::NodeRegistry& registry;
-  httplib::Server server;
+  GuardedServer server;
   int port = 0;
   station_detail::PixelCache pixels;
   std::mutex log_mutex;
   std::unique_ptr<StudyResumer> resumer;
 
   Impl(ServerOptions server_options, const workflow::NodeRegistry& node_registry)
-      : options(std::move(server_options)), registry(node_registry) {}
+      : options(std::move(server_options)), registry(node_registry), server(options.limits) {}
 
   void log(const std::string& line) {
     if (!options.log) return;
@@ -204,6 +204,45 @@ struct StationServer::Impl {
     throw NotFoundError("no study '" + study + "' under " + options.root.string());
   }
 
+  // The operator of the request's token; nullopt (and the 401 or 500
+  // response written) when there is none.
+  std::optional<std::string> authenticate(const httplib::Request& request,
+                                          httplib::Response& response) {
+    const std::string token = bearer_token(request);
+    std::optional<std::string> name;
+    try {
+      if (!token.empty()) name = operator_for_token(options.root, token);
+    } catch (const std::exception& error) {
+      log(request.method + " " + request.path + ": " + error.what());
+      send_error(response, 500, error.what(), "check the operators file of the root");
+      return std::nullopt;
+    }
+    if (!name) {
+      response.set_header("WWW-Authenticate", "Bearer");
+      send_error(response, 401,
+                 token.empty() ? "no operator token in the request" : "unknown operator token",
+                 kTokenHint);
+    }
+    return name;
+  }
+
+  // Runs after the headers and before the body is read: a chunked body
+  // (no length to check first) is refused, and an API request without a
+  // valid token is answered 401 without reading its body.
+  httplib::Server::HandlerResponse before_body(const httplib::Request& request,
+                                               httplib::Response& response) {
+    if (request.has_header("Transfer-Encoding")) {
+      send_error(response, 411, "chunked request bodies are not accepted",
+                 "send the body with a Content-Length (at most " +
+                     std::to_string(options.limits.max_body_bytes >> 10U) + " KiB)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (request.path.rfind("/api/", 0) == 0 && !authenticate(request, response)) {
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  }
+
   using ApiHandler =
       std::function<void(const httplib::Request&, httplib::Response&, const std::string&)>;
 
@@ -212,22 +251,8 @@ struct StationServer::Impl {
   httplib::Server::Handler api(ApiHandler handler) {
     return [this, handler = std::move(handler)](const httplib::Request& request,
                                                 httplib::Response& response) {
-      const std::string token = bearer_token(request);
-      std::optional<std::string> name;
-      try {
-        if (!token.empty()) name = operator_for_token(options.root, token);
-      } catch (const std::exception& error) {
-        log(request.method + " " + request.path + ": " + error.what());
-        send_error(response, 500, error.what(), "check the operators file of the root");
-        return;
-      }
-      if (!name) {
-        response.set_header("WWW-Authenticate", "Bearer");
-        send_error(response, 401,
-                   token.empty() ? "no operator token in the request" : "unknown operator token",
-                   kTokenHint);
-        return;
-      }
+      const std::optional<std::string> name = authenticate(request, response);
+      if (!name) return;
       try {
         handler(request, response, *name);
       } catch (const NotFoundError& error) {
@@ -385,6 +410,10 @@ struct StationServer::Impl {
   }
 
   void routes() {
+    server.set_pre_routing_handler(
+        [this](const httplib::Request& request, httplib::Response& response) {
+          return before_body(request, response);
+        });
     server.Get("/api/whoami", api([this](const httplib::Request&, httplib::Response& response,
                                          const std::string& name) { whoami(response, name); }));
     server.Get("/api/worklist",
@@ -450,8 +479,13 @@ StationServer::StationServer(ServerOptions options, const workflow::NodeRegistry
   impl.resumer = std::make_unique<StudyResumer>(
       impl.options.root, registry, resumer, [this](const std::string& line) { impl_->log(line); });
   impl.routes();
-  // A submission is a few kilobytes; anything much larger is a mistake.
-  impl.server.set_payload_max_length(std::size_t{1} << 20U);
+  if (!impl.options.tls_certificate.empty() || !impl.options.tls_key.empty()) {
+    if (impl.options.tls_certificate.empty() || impl.options.tls_key.empty()) {
+      throw InvalidInputError(
+          "HTTPS needs both a certificate and its private key (--tls-cert and --tls-key)");
+    }
+    impl.server.use_tls(impl.options.tls_certificate, impl.options.tls_key);
+  }
   // cpp-httplib's default socket options add SO_REUSEPORT, with which a
   // second server binds the port of a running one without an error (and the
   // kernel splits the connections between them). Only SO_REUSEADDR: a

@@ -14,7 +14,11 @@
 //   GET  /api/studies/{study}/status       node states (plan_study), tasks, the runner
 //
 // Every /api/ request carries an operator token (`mmm operator add NAME`) as
-// "Authorization: Bearer TOKEN"; without a valid one the answer is 401. The
+// "Authorization: Bearer TOKEN"; without a valid one the answer is 401, given
+// before any request body is read. Each connection serves one request within
+// the deadlines and sizes of options.limits (connection_limits.h); a chunked
+// request body is refused (411: send Content-Length). No CORS headers are
+// sent: browsers keep pages of other origins from reading the API. The
 // audit trail names the operator the token belongs to. Errors are JSON:
 // {"error": "...", "hint": "..."} with 400 (bad request), 401, 404 (no such
 // task, study or view), 409 (the task's state forbids it: TaskError), 500.
@@ -28,6 +32,7 @@
 
 #include "workflow/node_registry.h"
 #include "workflow/run/run_study.h"
+#include "worklists/http/connection_limits.h"
 
 namespace mmm::worklists::http {
 
@@ -41,6 +46,11 @@ struct ServerOptions {
   std::filesystem::path root;  // the studies' folder (the worklist's root)
   std::string host = "127.0.0.1";
   int port = 8080;  // 0: any free port (see StationServer::port)
+  // Per connection: deadlines, sizes, connections served at once.
+  ConnectionLimits limits;
+  // Both set: HTTPS with this PEM certificate chain and private key.
+  std::filesystem::path tls_certificate;
+  std::filesystem::path tls_key;
   // How resumed studies run (jobs, provenance recorded with each run).
   workflow::RunOptions run;
   std::string mmm_version;  // recorded in the audit trail with each action

@@ -78,6 +78,28 @@ TEST_F(StudyCliTest, FirstRunComputesEverythingAndTheSecondDoesNothing) {
   EXPECT_EQ(app::test::status_json(study_)["state"], "done");
 }
 
+// outputs/ behind the results (a run killed while exporting, a file edited
+// by hand): status says so and is not "done"; the next run re-exports.
+TEST_F(StudyCliTest, StatusSaysWhenOutputsDoNotMatchTheResultsAndARunReexports) {
+  ASSERT_EQ(run().exit_code, 0);
+  mmm::test::write_file(study_ / "outputs" / "full_report.json", "{}");
+  std::filesystem::remove(study_ / "outputs" / "side.ply");
+  const nlohmann::json stale = app::test::status_json(study_);
+  EXPECT_EQ(stale["state"], "outputs_stale");
+  EXPECT_FALSE(stale["outputs_match"].get<bool>());
+  const std::string reasons = stale["stale_outputs"].dump();
+  EXPECT_THAT(reasons, HasSubstr("outputs/full_report.json was changed after it was exported"));
+  EXPECT_THAT(reasons, HasSubstr("outputs/side.ply is missing"));
+  const CommandResult text = run_mmm("status " + study_.string());
+  EXPECT_THAT(text.out, HasSubstr("outputs   'side': outputs/side.ply is missing"));
+  const CommandResult rerun = run();
+  ASSERT_EQ(rerun.exit_code, 0) << rerun.err;
+  EXPECT_THAT(rerun.out, HasSubstr("exported to"));
+  const nlohmann::json fixed = app::test::status_json(study_);
+  EXPECT_EQ(fixed["state"], "done");
+  EXPECT_TRUE(fixed["outputs_match"].get<bool>());
+}
+
 TEST_F(StudyCliTest, ChangingAParameterRerunsExactlyItsDownstream) {
   ASSERT_EQ(run().exit_code, 0);
   const auto before = last_execution_ids(study_);

@@ -70,6 +70,16 @@ NodeRegistry make_registry() {
                  --g_running;
                  context.set_output("out", context.input_bytes("in"));
                });
+  registry.add(NodeSpec{"read_number", 1, "The number a text file holds"}
+                   .input<port::File>("file", "A text file")
+                   .output<port::Number>("out", "Its number"),
+               [](NodeContext& context) {
+                 const std::string text = context.input_bytes("file");
+                 if (text.find_first_not_of("0123456789.-") != std::string::npos) {
+                   throw IoError(context.input("file").path, "holds no number");
+                 }
+                 context.set_output("out", text);
+               });
   registry.add(NodeSpec{"approve", 1, "A person confirms a number"}
                    .input<port::Number>("in", "The number to confirm")
                    .output<port::Number>("out", "The confirmed number")
@@ -189,6 +199,31 @@ TEST_F(SchedulerTest, AnInputChangedInPlaceFailsTheNodeThatWouldReadIt) {
   ASSERT_TRUE(record.has_value());
   EXPECT_THAT(record->error, ::testing::HasSubstr("input 'b' of node 'd' is missing or was "
                                                   "changed after it was stored"));
+}
+
+// Errors of nodes name the files they read by their place in the store; the
+// recorded error names the file the user gave, and the input.
+TEST_F(SchedulerTest, ANodeErrorNamesTheFileTheUserGaveNotItsStoredCopy) {
+  const auto workflow = test::write_file(scratch_ / "wf.yaml", R"yaml(mmm_workflow: 1
+name: read
+inputs: {numbers: {type: File}}
+nodes:
+  - {id: read, type: read_number, inputs: {file: study.numbers}}
+outputs: {value: read.out}
+)yaml");
+  const auto given = test::write_file(scratch_ / "my numbers.txt", "not a number");
+  Study study = Study::create(
+      scratch_ / "study", {workflow, {{"numbers", given.string()}}, {"test", "test"}}, registry_);
+  const RunSummary failed = run(study);
+  EXPECT_THAT(failed.failed, ElementsAre("read"));
+  const std::optional<ExecutionRecord> record = last_execution(study.database(), "read");
+  ASSERT_TRUE(record.has_value());
+  EXPECT_THAT(record->error, ::testing::HasSubstr("'" + std::filesystem::absolute(given).string() +
+                                                  "' (study input 'numbers'): holds no number"));
+  EXPECT_THAT(record->error, ::testing::Not(::testing::HasSubstr("artifacts/")));
+  const std::vector<LogLine> logs = execution_logs(study.database(), record->id);
+  ASSERT_FALSE(logs.empty());
+  EXPECT_EQ(logs.back().message, record->error);
 }
 
 TEST_F(SchedulerTest, AManualNodeMakesTheStudyWaitAndBlocksOnlyItsDownstream) {
