@@ -43,7 +43,7 @@ std::vector<WorklistEntry> list_worklist(const std::filesystem::path& root,
 // Throws InvalidInputError when there is none (with a hint), when the id is
 // in several studies (a copied study folder keeps its task ids: the studies
 // are named, none is picked) or the prefix is ambiguous (listing the matches).
-WorklistEntry locate_task(const std::filesystem::path& root, const std::string& id);
+WorklistEntry locate_task(const std::filesystem::path& root, const std::string& given);
 
 // "3 h 12 min", "45 s", "2 d 4 h": an age for people.
 std::string format_age(double seconds);

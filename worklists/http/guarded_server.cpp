@@ -20,7 +20,7 @@ namespace mmm::worklists::http {
 
 struct GuardedServer::Tls {
   struct ContextDeleter {
-    void operator()(SSL_CTX* context) const { SSL_CTX_free(context); }
+    void operator()(SSL_CTX* ssl_context) const { SSL_CTX_free(ssl_context); }
   };
   std::unique_ptr<SSL_CTX, ContextDeleter> context;
 };

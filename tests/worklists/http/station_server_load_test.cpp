@@ -12,6 +12,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -54,7 +55,7 @@ class RawConnection {
   [[nodiscard]] bool connected() const { return connected_; }
 
   // false once the server has closed the connection.
-  bool send_text(const std::string& text) {
+  bool send_text(const std::string& text) const {
     return ::send(fd_, text.data(), text.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(text.size());
   }
 
@@ -65,8 +66,8 @@ class RawConnection {
     while (std::chrono::steady_clock::now() < until) {
       pollfd entry{fd_, POLLIN, 0};
       if (::poll(&entry, 1, 50) <= 0) continue;
-      char buffer[4096];
-      if (::recv(fd_, buffer, sizeof(buffer), 0) <= 0) return true;
+      std::array<char, 4096> buffer{};
+      if (::recv(fd_, buffer.data(), buffer.size(), 0) <= 0) return true;
     }
     return false;
   }
@@ -78,10 +79,10 @@ class RawConnection {
     while (std::chrono::steady_clock::now() < until) {
       pollfd entry{fd_, POLLIN, 0};
       if (::poll(&entry, 1, 50) <= 0) continue;
-      char buffer[4096];
-      const ssize_t got = ::recv(fd_, buffer, sizeof(buffer), 0);
+      std::array<char, 4096> buffer{};
+      const ssize_t got = ::recv(fd_, buffer.data(), buffer.size(), 0);
       if (got <= 0) break;
-      out.append(buffer, static_cast<std::size_t>(got));
+      out.append(buffer.data(), static_cast<std::size_t>(got));
     }
     return out;
   }
@@ -114,7 +115,7 @@ class StationServerLoadTest : public ::testing::Test {
   }
 
   test::ScratchDir dir_{"station-load"};
-  const workflow::NodeRegistry registry_;
+  const workflow::NodeRegistry registry_{};
   std::unique_ptr<StationServer> server_;
   std::thread runner_;
 };
@@ -129,6 +130,7 @@ TEST_F(StationServerLoadTest, SlowClientsAreCutOffAndOperatorsAreStillAnswered) 
   constexpr int kSlowClients = 12;
   std::atomic<int> cut_off{0};
   std::vector<std::thread> slow;
+  slow.reserve(kSlowClients);
   for (int i = 0; i < kSlowClients; ++i) {
     slow.emplace_back([port, &cut_off] {
       RawConnection connection(port);
@@ -153,12 +155,13 @@ TEST_F(StationServerLoadTest, SlowClientsAreCutOffAndOperatorsAreStillAnswered) 
   constexpr int kRequests = 3;
   std::atomic<int> answered{0};
   std::vector<std::thread> operators;
+  operators.reserve(kOperators);
   for (int i = 0; i < kOperators; ++i) {
     operators.emplace_back([port, &token, &answered] {
       httplib::Client client("127.0.0.1", port);
       client.set_connection_timeout(10s);
       client.set_read_timeout(10s);
-      client.set_bearer_token_auth(token.c_str());
+      client.set_bearer_token_auth(token);
       for (int k = 0; k < kRequests; ++k) {
         const httplib::Result result = client.Get("/api/whoami");
         if (result && result->status == 200 &&
@@ -224,7 +227,7 @@ TEST_F(StationServerLoadTest, OversizeBodiesAndRequestsWithoutATokenAreAnsweredF
   }
   // ... and the server still answers.
   httplib::Client client("127.0.0.1", server_->port());
-  client.set_bearer_token_auth(token.c_str());
+  client.set_bearer_token_auth(token);
   const httplib::Result result = client.Get("/api/whoami");
   ASSERT_TRUE(result);
   EXPECT_EQ(result->status, 200);
@@ -269,7 +272,7 @@ TEST_F(StationServerLoadTest, ServesHttpsWithTheGivenCertificateAndRefusesClearT
 
   httplib::SSLClient secure("127.0.0.1", server_->port());
   secure.enable_server_certificate_verification(false);  // self-signed for the test
-  secure.set_bearer_token_auth(token.c_str());
+  secure.set_bearer_token_auth(token);
   const httplib::Result result = secure.Get("/api/whoami");
   ASSERT_TRUE(result) << httplib::to_string(result.error());
   EXPECT_EQ(result->status, 200);
@@ -277,7 +280,7 @@ TEST_F(StationServerLoadTest, ServesHttpsWithTheGivenCertificateAndRefusesClearT
 
   httplib::Client clear("127.0.0.1", server_->port());
   clear.set_read_timeout(3s);
-  clear.set_bearer_token_auth(token.c_str());
+  clear.set_bearer_token_auth(token);
   const httplib::Result refused = clear.Get("/api/whoami");
   EXPECT_FALSE(refused && refused->status == 200);
 }
