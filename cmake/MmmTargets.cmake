@@ -2,6 +2,17 @@
 # warnings as errors on our code, third-party headers as SYSTEM (imported
 # targets), optional sanitizers.
 
+# The UBSan ignore list (clang): copied into the build folder under a name
+# that carries its content hash, so that a changed list changes the compile
+# command (and the compiler cache's key) while the path stays relative.
+if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang" AND MMM_SANITIZE MATCHES "undefined")
+  file(MD5 ${PROJECT_SOURCE_DIR}/cmake/ubsan_third_party_ignorelist.txt mmm_ignorelist_md5)
+  string(SUBSTRING ${mmm_ignorelist_md5} 0 12 mmm_ignorelist_md5)
+  set(MMM_UBSAN_IGNORELIST ubsan_ignorelist_${mmm_ignorelist_md5}.txt)
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/ubsan_third_party_ignorelist.txt
+                 ${CMAKE_BINARY_DIR}/${MMM_UBSAN_IGNORELIST} COPYONLY)
+endif()
+
 function(mmm_target_settings target)
   target_compile_options(${target} PRIVATE
     -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast
@@ -22,9 +33,12 @@ function(mmm_target_settings target)
     if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
       target_compile_options(${target} PRIVATE -Wno-maybe-uninitialized)
     endif()
-    if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang" AND MMM_SANITIZE MATCHES "undefined")
-      target_compile_options(${target} PRIVATE
-        -fsanitize-ignorelist=${PROJECT_SOURCE_DIR}/cmake/ubsan_third_party_ignorelist.txt)
+    if(MMM_UBSAN_IGNORELIST)
+      # Relative to the build folder, where Ninja runs every compile: the
+      # same command line in every clone, so the compiler cache hits across
+      # clones (an absolute path here made every sanitizer compile of another
+      # clone a miss).
+      target_compile_options(${target} PRIVATE -fsanitize-ignorelist=${MMM_UBSAN_IGNORELIST})
     endif()
     # The standard library's own checks (bounds of vector/string/array
     # indexing, front() of an empty container, ...): they cover OpenMesh's
