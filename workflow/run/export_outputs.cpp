@@ -77,6 +77,16 @@ std::string read_all(const std::filesystem::path& file) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+// The current result an export shows; nullptr when its node has none.
+const OutputArtifact* current_artifact(
+    const std::map<std::string, std::map<std::string, OutputArtifact>>& results,
+    const WorkflowOutput& output) {
+  const auto node = results.find(output.source.node);
+  if (node == results.end()) return nullptr;
+  const auto port = node->second.find(output.source.port);
+  return port == node->second.end() ? nullptr : &port->second;
+}
+
 // Whether two files hold the same bytes (sizes first).
 bool same_content(const std::filesystem::path& a, const std::filesystem::path& b) {
   std::error_code error;
@@ -141,12 +151,7 @@ ExportReport export_outputs(
   std::filesystem::create_directories(folder);
   std::map<std::string, RecordedExport> recorded = recorded_exports(study.database());
   for (const WorkflowOutput& output : study.workflow().outputs) {
-    const auto node = available.find(output.source.node);
-    const OutputArtifact* artifact = nullptr;
-    if (node != available.end()) {
-      const auto port = node->second.find(output.source.port);
-      if (port != node->second.end()) artifact = &port->second;
-    }
+    const OutputArtifact* artifact = current_artifact(available, output);
     const auto previous = recorded.find(output.name);
     std::error_code error;
     if (artifact == nullptr) {
@@ -203,12 +208,7 @@ std::vector<std::string> stale_exports(
   const std::filesystem::path folder = study.outputs_dir();
   const std::map<std::string, RecordedExport> recorded = recorded_exports(study.database());
   for (const WorkflowOutput& output : study.workflow().outputs) {
-    const OutputArtifact* artifact = nullptr;
-    if (const auto node = results.find(output.source.node); node != results.end()) {
-      if (const auto port = node->second.find(output.source.port); port != node->second.end()) {
-        artifact = &port->second;
-      }
-    }
+    const OutputArtifact* artifact = current_artifact(results, output);
     const auto previous = recorded.find(output.name);
     const std::string name = "'" + output.name + "': ";
     if (artifact == nullptr) {

@@ -57,6 +57,13 @@ bool wait_for(socket_t sock, short events, Clock::time_point deadline) {
   }
 }
 
+// What OpenSSL waits for after `result` of an SSL_* call on a non-blocking
+// socket: POLLIN, POLLOUT, or 0 when the call failed for good.
+short events_awaited(SSL* ssl, int result) {
+  const int error = SSL_get_error(ssl, result);
+  return error == SSL_ERROR_WANT_READ ? POLLIN : error == SSL_ERROR_WANT_WRITE ? POLLOUT : 0;
+}
+
 // One request's worth of a socket, in clear or through TLS: reads end at the
 // request deadline or after `max_read_bytes`, writes at the response deadline
 // (both return -1 then, which makes cpp-httplib drop the connection).
@@ -129,11 +136,8 @@ class DeadlineStream final : public httplib::Stream {
     for (;;) {
       const int got = SSL_read(ssl_, buffer_.data(), static_cast<int>(room));
       if (got > 0) return got;
-      const int error = SSL_get_error(ssl_, got);
-      if (error == SSL_ERROR_ZERO_RETURN) return 0;
-      const short events = error == SSL_ERROR_WANT_READ    ? POLLIN
-                           : error == SSL_ERROR_WANT_WRITE ? POLLOUT
-                                                           : 0;
+      if (SSL_get_error(ssl_, got) == SSL_ERROR_ZERO_RETURN) return 0;
+      const short events = events_awaited(ssl_, got);
       if (events == 0 || !wait_for(sock_, events, read_deadline_)) {
         ERR_clear_error();
         return -1;
@@ -146,10 +150,7 @@ class DeadlineStream final : public httplib::Stream {
     for (;;) {
       const int sent = SSL_write(ssl_, ptr, chunk);
       if (sent > 0) return sent;
-      const int error = SSL_get_error(ssl_, sent);
-      const short events = error == SSL_ERROR_WANT_READ    ? POLLIN
-                           : error == SSL_ERROR_WANT_WRITE ? POLLOUT
-                                                           : 0;
+      const short events = events_awaited(ssl_, sent);
       if (events == 0 || !wait_for(sock_, events, write_deadline())) {
         ERR_clear_error();
         return -1;
@@ -207,10 +208,7 @@ SslHandle accept_tls(SSL_CTX* context, socket_t sock, Clock::time_point deadline
   for (;;) {
     const int done = SSL_accept(ssl.get());
     if (done == 1) return ssl;
-    const int error = SSL_get_error(ssl.get(), done);
-    const short events = error == SSL_ERROR_WANT_READ    ? POLLIN
-                         : error == SSL_ERROR_WANT_WRITE ? POLLOUT
-                                                         : 0;
+    const short events = events_awaited(ssl.get(), done);
     if (events == 0 || !wait_for(sock, events, deadline)) {
       ERR_clear_error();
       return nullptr;
