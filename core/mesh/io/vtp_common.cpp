@@ -276,6 +276,12 @@ Cells read_cells(const std::filesystem::path& path, const tinyxml2::XMLElement& 
                               " points (offsets must increase by at least " +
                               std::to_string(min_points) + ")");
     }
+    if (end > static_cast<std::int64_t>(connectivity.size())) {
+      throw IoError(path, at_line(*offsets_array) + label + " cell " + std::to_string(c) +
+                              " ends at offset " + std::to_string(end) +
+                              " but the connectivity holds " + std::to_string(connectivity.size()) +
+                              " entries");
+    }
     for (std::int64_t k = start; k < end; ++k) {
       const std::int64_t index = connectivity[static_cast<std::size_t>(k)];
       if (index < 0 || index >= num_points) {
