@@ -91,6 +91,7 @@ struct RunArgs {
   double wait_seconds = std::chrono::duration<double>(worklists::kBriefLockWait).count();
   bool quiet = false;
   bool show_cached = false;
+  bool retry_crashed = false;
 };
 
 void print_summary(const workflow::RunSummary& summary, const std::string& dir) {
@@ -134,6 +135,7 @@ void run_run(const RunArgs& args, const workflow::NodeRegistry& registry) {
       std::cerr, {.terminal = terminal, .show_cached = args.show_cached});
   workflow::RunOptions options;
   options.jobs = args.jobs;
+  options.retry_crashed = args.retry_crashed;
   options.provenance = this_program();
   options.observer = args.quiet ? nullptr : display.get();
   const worklists::StudyRunResult result = worklists::run_study_with_tasks(
@@ -201,6 +203,9 @@ void register_study_commands(CLI::App& app, const workflow::NodeRegistry& regist
       ->check(CLI::Range(0.0, 1e6));
   run->add_flag("--quiet,-q", run_args->quiet, "Print only the summary");
   run->add_flag("--show-cached", run_args->show_cached, "Print a line for every reused node");
+  run->add_flag("--retry-crashed", run_args->retry_crashed,
+                "Run again the nodes that crashed mmm with the same inputs and parameters "
+                "(otherwise they are reported as failed)");
   run->callback([run_args, &registry] { run_run(*run_args, registry); });
 
   register_study_report_commands(app, registry);

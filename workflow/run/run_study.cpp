@@ -15,8 +15,10 @@
 #include "workflow/definition/workflow_graph.h"
 #include "workflow/fault_injection.h"
 #include "workflow/host_and_time.h"
+#include "workflow/run/crash_marker.h"
 #include "workflow/run/export_outputs.h"
 #include "workflow/run/study_plan.h"
+#include "workflow/study/crash_records.h"
 
 namespace mmm::workflow {
 namespace {
@@ -38,6 +40,7 @@ struct Completion {
 struct Job {
   std::string node;
   std::int64_t execution_id = 0;
+  std::string cache_key;
   const NodeType* type = nullptr;
   std::map<std::string, ArtifactRef> inputs;
   std::map<std::string, ParamValue> params;
@@ -195,7 +198,8 @@ std::vector<std::string> declared_outputs_missing(const NodeSpec& spec,
 
 // Runs one node in a worker thread; never throws.
 Completion execute(const Job& job, ArtifactStore& artifacts,
-                   const std::filesystem::path& scratch_root, RunObserver* observer) {
+                   const std::filesystem::path& scratch_root,
+                   const std::filesystem::path& crash_marker, RunObserver* observer) {
   const auto start = Clock::now();
   Completion completion{job.node, job.execution_id, {}, {}, {}, 0};
   std::mutex log_mutex;
@@ -238,7 +242,10 @@ Completion execute(const Job& job, ArtifactStore& artifacts,
     std::filesystem::create_directories(scratch);
     NodeContext context(job.type->spec, job.inputs, job.params, scratch, channels);
     fault_point("node.before_run");
-    job.type->run(context);
+    {
+      const RunningNodeScope crash_scope(crash_marker, job.node, job.cache_key);
+      job.type->run(context);
+    }
     fault_point("node.after_run");
     const std::vector<std::string> missing =
         declared_outputs_missing(job.type->spec, context.outputs());
@@ -283,7 +290,8 @@ class Scheduler {
         options_(options),
         batch_(study.database(), study.artifacts(), options.commit_interval),
         pool_(std::max(1, options.jobs), [this](Job& job) {
-          completions_.push(execute(job, study_.artifacts(), scratch_root_, options_.observer));
+          completions_.push(
+              execute(job, study_.artifacts(), scratch_root_, crash_marker_, options_.observer));
         }) {}
 
   RunSummary run() {
@@ -334,6 +342,12 @@ class Scheduler {
     inputs_ = study_.inputs();
     Database& database = study_.database();
     Transaction transaction(database);
+    // The nodes that crashed the process are recorded first (their executions
+    // become 'failed'); whatever else was running was interrupted.
+    const std::vector<MarkedCrash> crashes = read_crash_marker(crash_marker_);
+    for (const MarkedCrash& crash : crashes) {
+      record_crash(database, {crash.node, crash.cache_key, crash.signal, utc_now()});
+    }
     mark_interrupted(database);
     database
         .prepare(
@@ -348,6 +362,8 @@ class Scheduler {
         .bind_int64(7, std::max(1, options_.jobs));
     summary_.run_id = database.last_insert_rowid();
     transaction.commit();
+    std::error_code ignored;
+    std::filesystem::remove(crash_marker_, ignored);
     fault_point("run.started");
   }
 
@@ -392,6 +408,12 @@ class Scheduler {
       if (observer() != nullptr) observer()->node_waiting(id);
       return;
     }
+    if (!options_.retry_crashed) {
+      if (const std::optional<CrashRecord> crash = find_crash(database, id, key)) {
+        record_crashed(node, *type, parts, *crash, inputs);
+        return;
+      }
+    }
     ExecutionRecord record;
     record.run_id = summary_.run_id;
     record.node = id;
@@ -408,7 +430,7 @@ class Scheduler {
     running_records_[id] = record;
     ++running_;
     if (observer() != nullptr) observer()->node_started(id, record.node_type, record.reason);
-    pool_.submit(Job{id, execution_id, type, std::move(inputs), std::move(parts.params)});
+    pool_.submit(Job{id, execution_id, key, type, std::move(inputs), std::move(parts.params)});
   }
 
   void record_invalid(const NodeInstance& node, const NodeType& type, const std::string& error) {
@@ -429,6 +451,38 @@ class Scheduler {
     summary_.failed.push_back(node.id);
     settled_.insert(node.id);
     if (observer() != nullptr) observer()->node_finished(node.id, false, 0, error);
+  }
+
+  // A node that crashed the process with this cache key is not run again:
+  // it fails, naming the crash and the user's files it reads.
+  void record_crashed(const NodeInstance& node, const NodeType& type, const CacheKeyParts& parts,
+                      const CrashRecord& crash, const std::map<std::string, ArtifactRef>& inputs) {
+    ExecutionRecord record;
+    record.run_id = summary_.run_id;
+    record.node = node.id;
+    record.node_type = type.spec.name();
+    record.version = type.spec.version();
+    record.cache_key = crash.cache_key;
+    record.key_parts = parts;
+    record.status = ExecutionStatus::kFailed;
+    record.reason = "it crashed mmm with these inputs and parameters; not run again";
+    record.error = crash_error(crash);
+    std::string files;
+    for (const auto& [port, ref] : inputs) {
+      for (const auto& [name, input] : inputs_) {
+        if (!input.is_file || input.hash != ref.hash) continue;
+        files += (files.empty() ? "" : ", ") +
+                 ("'" + input.given + "' (study input '" + name + "', read as '" + port + "')");
+      }
+    }
+    if (!files.empty()) record.error += "; the files it reads: " + files;
+    record.started_at = record.finished_at = utc_now_precise();
+    record.host = host_name();
+    record.pid = ::getpid();
+    insert_execution(batch_.write(), record);
+    summary_.failed.push_back(node.id);
+    settled_.insert(node.id);
+    if (observer() != nullptr) observer()->node_finished(node.id, false, 0, record.error);
   }
 
   // A node's error names the files it read by their place in the store
@@ -510,6 +564,8 @@ class Scheduler {
   DeferredSync durability_;
   const RunOptions& options_;
   std::filesystem::path scratch_root_ = study_.scratch_dir();
+  std::filesystem::path crash_marker_ = study_.crash_marker();
+  CrashHandlers crash_handlers_;
   RunSummary summary_;
   std::map<std::string, StudyInputRecord> inputs_;
   std::map<std::string, int> waiting_for_;  // node -> upstream nodes without a result

@@ -47,6 +47,9 @@ struct RunOptions {
   RunObserver* observer = nullptr;
   // Longest delay between a node finishing and its record being committed.
   std::chrono::milliseconds commit_interval{200};
+  // Run nodes that crashed the process before with the same cache key
+  // (normally they are reported as failed: crash_records.h).
+  bool retry_crashed = false;
 };
 
 enum class RunOutcome {

@@ -4,6 +4,8 @@
 
 #include "core/errors.h"
 #include "workflow/definition/workflow_graph.h"
+#include "workflow/run/crash_marker.h"
+#include "workflow/study/crash_records.h"
 
 namespace mmm::workflow {
 namespace {
@@ -12,6 +14,20 @@ std::string join_sentences(const std::vector<std::string>& parts) {
   std::string text;
   for (const std::string& part : parts) text += (text.empty() ? "" : "; ") + part;
   return text;
+}
+
+// A crash recorded for the node with this key, or one its marker names (the
+// run that reads the marker has not happened yet).
+std::optional<CrashRecord> crash_of(Study& study, const std::vector<MarkedCrash>& marked,
+                                    const std::string& node, const std::string& cache_key) {
+  std::optional<CrashRecord> crash = find_crash(study.database(), node, cache_key);
+  if (crash) return crash;
+  for (const MarkedCrash& mark : marked) {
+    if (mark.node == node && mark.cache_key == cache_key) {
+      return CrashRecord{node, cache_key, mark.signal, "at the next run"};
+    }
+  }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -119,6 +135,7 @@ StudyPlan plan_study(Study& study, bool refresh_inputs) {
   const std::map<std::string, StudyInputRecord> inputs = study.inputs();
   const WorkflowDefinition& workflow = study.workflow();
   std::map<std::string, std::map<std::string, OutputArtifact>> available;
+  const std::vector<MarkedCrash> marked_crashes = read_crash_marker(study.crash_marker());
   for (const std::string& id : topological_order(workflow)) {
     NodePlan node_plan;
     node_plan.node = workflow.find_node(id);
@@ -160,6 +177,10 @@ StudyPlan plan_study(Study& study, bool refresh_inputs) {
     } else if (spec.is_manual()) {
       node_plan.state = NodeState::kWaiting;
       node_plan.reason = "waits for a person to provide its result (manual node)";
+    } else if (std::optional<CrashRecord> crash =
+                   crash_of(study, marked_crashes, id, node_plan.cache_key)) {
+      node_plan.state = NodeState::kFailed;
+      node_plan.reason = crash_error(*crash);
     } else {
       const bool failed_before = node_plan.last &&
                                  node_plan.last->cache_key == node_plan.cache_key &&

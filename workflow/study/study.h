@@ -80,6 +80,8 @@ class Study {
   [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
   [[nodiscard]] std::filesystem::path outputs_dir() const { return dir_ / "outputs"; }
   [[nodiscard]] std::filesystem::path scratch_dir() const { return dir_ / "scratch"; }
+  // Where a node that crashes the process is named (workflow/run/crash_marker.h).
+  [[nodiscard]] std::filesystem::path crash_marker() const { return dir_ / "crash-marker"; }
   [[nodiscard]] const WorkflowDefinition& workflow() const { return workflow_; }
   [[nodiscard]] const NodeRegistry& registry() const { return *registry_; }
   [[nodiscard]] Database& database() { return database_; }

@@ -67,6 +67,13 @@ CREATE TABLE IF NOT EXISTS logs(
   level TEXT NOT NULL,
   message TEXT NOT NULL);
 CREATE INDEX IF NOT EXISTS logs_by_execution ON logs(execution_id);
+CREATE TABLE IF NOT EXISTS crashes(
+  id INTEGER PRIMARY KEY,
+  node TEXT NOT NULL,
+  cache_key TEXT NOT NULL,
+  signal INTEGER NOT NULL,
+  noticed_at TEXT NOT NULL);
+CREATE INDEX IF NOT EXISTS crashes_by_key ON crashes(cache_key, node);
 CREATE TABLE IF NOT EXISTS exports(
   name TEXT PRIMARY KEY,
   hash TEXT NOT NULL,

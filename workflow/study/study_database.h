@@ -9,6 +9,8 @@
 //                                    result): cache key, outputs, status,
 //                                    times, error, reason it ran
 //   logs(execution_id, ...)          log lines of each execution
+//   crashes(node, cache_key, ...)    nodes that crashed the process, with the
+//                                    signal (not run again with that key)
 //   exports(name, hash, file)        the exported outputs currently in outputs/
 
 #include "workflow/store/sqlite.h"
