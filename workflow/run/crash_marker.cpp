@@ -9,9 +9,9 @@
 #include <csignal>
 #include <cstring>
 #include <fstream>
-#include <memory>
 #include <mutex>
 #include <sstream>
+#include <vector>
 
 namespace mmm::workflow {
 namespace {
@@ -39,7 +39,7 @@ class AltStack {
  public:
   AltStack() = default;
   ~AltStack() {
-    if (!memory_) return;
+    if (memory_.empty()) return;
     stack_t disable{};
     disable.ss_flags = SS_DISABLE;
     ::sigaltstack(&disable, nullptr);
@@ -50,18 +50,18 @@ class AltStack {
   AltStack& operator=(AltStack&&) = delete;
 
   void ensure() {
-    if (memory_) return;
+    if (!memory_.empty()) return;
     stack_t current{};
     if (::sigaltstack(nullptr, &current) != 0 || (current.ss_flags & SS_DISABLE) == 0) return;
-    memory_ = std::make_unique<char[]>(kAltStackBytes);
+    memory_.resize(kAltStackBytes);
     stack_t stack{};
-    stack.ss_sp = memory_.get();
-    stack.ss_size = kAltStackBytes;
-    if (::sigaltstack(&stack, nullptr) != 0) memory_.reset();
+    stack.ss_sp = memory_.data();
+    stack.ss_size = memory_.size();
+    if (::sigaltstack(&stack, nullptr) != 0) memory_ = {};
   }
 
  private:
-  std::unique_ptr<char[]> memory_;
+  std::vector<char> memory_;
 };
 
 thread_local AltStack t_alt_stack;

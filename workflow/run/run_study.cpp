@@ -471,8 +471,9 @@ class Scheduler {
     for (const auto& [port, ref] : inputs) {
       for (const auto& [name, input] : inputs_) {
         if (!input.is_file || input.hash != ref.hash) continue;
-        files += (files.empty() ? "" : ", ") +
-                 ("'" + input.given + "' (study input '" + name + "', read as '" + port + "')");
+        files.append(files.empty() ? "'" : ", '").append(input.given);
+        files.append("' (study input '").append(name).append("', read as '").append(port);
+        files.append("')");
       }
     }
     if (!files.empty()) record.error += "; the files it reads: " + files;

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <csignal>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -31,7 +32,7 @@ namespace {
 bool g_crash_allowed = false;
 
 int overflow_the_stack(int depth) {
-  volatile char frame[1024];
+  std::array<volatile char, 1024> frame{};
   frame[0] = static_cast<char>(depth);
   if (depth > 1'000'000'000) return frame[0];
   return overflow_the_stack(depth + 1) + frame[0];
