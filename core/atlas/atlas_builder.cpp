@@ -13,6 +13,7 @@
 #include "core/atlas/bone_registration.h"
 #include "core/atlas/muscle_cleanup.h"
 #include "core/atlas/opensim_mapping.h"
+#include "core/atlas/surface_line.h"
 #include "core/errors.h"
 #include "core/fit/sphere_fit.h"
 #include "core/mesh/aabb_tree.h"
@@ -506,7 +507,26 @@ void Builder::build_muscles() {
       slack_length += scale * source->tendon_slack_length;
       pennation += source->pennation_angle_at_optimal;
     }
-    if (const auto lines = static_cast<double>(recipe_muscle.action_lines.size()); lines > 0) {
+    if (!recipe_muscle.surface_line.empty()) {
+      const std::string& origin = recipe_muscle.surface_line[0];
+      const std::string& insertion = recipe_muscle.surface_line[1];
+      const mesh::AabbTree origin_tree(bone_meshes_.at(origin));
+      const mesh::AabbTree insertion_tree(bone_meshes_.at(insertion));
+      SurfaceLine line = surface_action_line(
+          recipe_muscle.name, muscle_meshes_.at(recipe_muscle.name), {origin, &origin_tree},
+          {insertion, &insertion_tree}, recipe_.attachment_distance_mm);
+      muscle.action_lines.push_back(std::move(line.line));
+      // Lengths from the geometry: the belly along the line is the fibre
+      // length, the rest of the line the tendon.
+      muscle.optimal_fibre_length_mm = line.belly_mm;
+      muscle.tendon_slack_length_mm = line.tendon_mm;
+      report_.notes.push_back(recipe_muscle.name +
+                              ": no OpenSim path; its action line runs between its contacts with " +
+                              origin + " and " + insertion +
+                              " (fibre and tendon lengths from its surface; no force)");
+    }
+    if (const auto lines = static_cast<double>(recipe_muscle.action_lines.size());
+        lines > 0 && recipe_muscle.surface_line.empty()) {
       muscle.optimal_fibre_length_mm = fibre_length / lines;
       muscle.tendon_slack_length_mm = slack_length / lines;
       muscle.pennation_angle_rad = pennation / lines;

@@ -319,15 +319,31 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
   }
 
   index = 0;
-  for (const YAML::Node& item :
-       reader.items(root, "muscles",
-                    {"name", "file", "mirror", "action_lines", "architecture", "region", "tags"})) {
+  for (const YAML::Node& item : reader.items(root, "muscles",
+                                             {"name", "file", "mirror", "action_lines",
+                                              "surface_line", "architecture", "region", "tags"})) {
     const std::string field = "muscles[" + std::to_string(index++) + "]";
     RecipeMuscle muscle;
     muscle.name = reader.text(item, "name", field, true);
     muscle.file = reader.text(item, "file", field, true);
     muscle.mirror = reader.flag(item, "mirror", field, false);
     muscle.action_lines = reader.texts(item, "action_lines", field);
+    muscle.surface_line = reader.texts(item, "surface_line", field);
+    if (!muscle.surface_line.empty()) {
+      if (muscle.surface_line.size() != 2) {
+        reader.fail(item["surface_line"], field + ".surface_line",
+                    "expects two bones: [origin bone, insertion bone]");
+      }
+      for (const std::string& bone : muscle.surface_line) {
+        if (!has_bone(bone)) {
+          reader.fail(item["surface_line"], field + ".surface_line", "unknown bone '" + bone + "'");
+        }
+      }
+      if (!muscle.action_lines.empty()) {
+        reader.fail(item["surface_line"], field + ".surface_line",
+                    "a muscle has either action_lines (OpenSim paths) or a surface_line");
+      }
+    }
     const std::string architecture = reader.text(item, "architecture", field);
     if (!architecture.empty()) {
       const auto parsed = fibre_architecture_from_name(architecture);

@@ -80,6 +80,11 @@ struct RecipeMuscle {
   std::string file;
   bool mirror = false;
   std::vector<std::string> action_lines;  // OpenSim muscle names (their paths become action lines)
+  // For a muscle the OpenSim model has no path for: [origin bone, insertion
+  // bone]. One action line named like the muscle runs from the middle of the
+  // muscle's contact with the first bone to that with the second (then kept
+  // inside the muscle like any line).
+  std::vector<std::string> surface_line;
   FibreArchitecture architecture = FibreArchitecture::kParallel;
   std::string region;
   std::vector<std::string> tags;

@@ -78,9 +78,9 @@ TEST(AtlasRecipeTest, DefaultRecipeReads) {
   EXPECT_EQ(recipe.midline_bone, "sacrum");
   EXPECT_EQ(recipe.lod_faces, (std::vector<int>{4000, 1000}));
   EXPECT_EQ(recipe.regions.size(), 4U);
-  EXPECT_EQ(recipe.bones.size(), 10U);
+  EXPECT_EQ(recipe.bones.size(), 16U);
   EXPECT_EQ(recipe.registrations.size(), 6U);
-  EXPECT_EQ(recipe.muscles.size(), 21U);  // 20 right-leg muscles + the mirrored left one
+  EXPECT_EQ(recipe.muscles.size(), 38U);  // 37 right-leg muscles + the mirrored left one
   EXPECT_EQ(recipe.landmarks.size(), 13U);
   for (const std::string_view required : kRequiredLandmarks) {
     EXPECT_TRUE(std::ranges::any_of(recipe.landmarks, [&](const RecipeLandmark& l) {
@@ -110,9 +110,17 @@ TEST(AtlasRecipeTest, DefaultRecipeReads) {
       std::ranges::find(recipe.muscles, std::string("gluteus_maximus_r"), &RecipeMuscle::name);
   ASSERT_NE(gmax, recipe.muscles.end());
   EXPECT_EQ(gmax->action_lines.size(), 3U);
-  EXPECT_EQ(recipe.bones.front().opensim_meshes,
-            (std::vector<std::string>{"pelvis.vtp", "l_pelvis.vtp"}));
-  EXPECT_DOUBLE_EQ(recipe.bones.front().remesh_edge_mm, 4.0);
+  // One subject: every bone is a surface of hers, none an OpenSim mesh.
+  for (const RecipeBone& bone : recipe.bones) {
+    EXPECT_FALSE(bone.file.empty()) << bone.name;
+    EXPECT_TRUE(bone.opensim_meshes.empty()) << bone.name;
+  }
+  EXPECT_EQ(recipe.bones.front().file, "vhf/registered/VHF_Right_Bone_Pelvis_registered.stl");
+  const auto popliteus =
+      std::ranges::find(recipe.muscles, std::string("popliteus_r"), &RecipeMuscle::name);
+  ASSERT_NE(popliteus, recipe.muscles.end());
+  EXPECT_EQ(popliteus->surface_line, (std::vector<std::string>{"femur_r", "tibia_r"}));
+  EXPECT_TRUE(popliteus->action_lines.empty());
 }
 
 TEST(AtlasRecipeTest, SmallRecipeReads) {
@@ -173,6 +181,18 @@ TEST(AtlasRecipeTest, UnknownTargetBoneIsRejected) {
   EXPECT_THAT(rejection(edited("bone: femur_r, method: joint_centre",
                                "bone: femoral, method: joint_centre")),
               HasSubstr("landmarks[1].bone: unknown bone 'femoral'"));
+}
+
+TEST(AtlasRecipeTest, ASurfaceLineNeedsTwoKnownBonesAndNoOpenSimPath) {
+  EXPECT_EQ(rejection(edited("action_lines: [glut_max1_r]", "surface_line: [sacrum, femur_r]")),
+            "");
+  EXPECT_THAT(rejection(edited("action_lines: [glut_max1_r]", "surface_line: [sacrum]")),
+              HasSubstr("muscles[0].surface_line: expects two bones"));
+  EXPECT_THAT(rejection(edited("action_lines: [glut_max1_r]", "surface_line: [sacrum, femr]")),
+              HasSubstr("muscles[0].surface_line: unknown bone 'femr'"));
+  EXPECT_THAT(rejection(edited("action_lines: [glut_max1_r]",
+                               "action_lines: [glut_max1_r], surface_line: [sacrum, femur_r]")),
+              HasSubstr("either action_lines (OpenSim paths) or a surface_line"));
 }
 
 TEST(AtlasRecipeTest, DuplicateNamesAreRejected) {
