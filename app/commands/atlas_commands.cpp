@@ -1,6 +1,7 @@
 // mmm atlas build|check: the command-line face of core/atlas.
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -197,6 +198,7 @@ struct CheckArgs {
   bool json = false;
   double max_penetration_mm = 1.0;
   double min_inside = 0.8;
+  atlas::AnatomyLimits anatomy;
 };
 
 nlohmann::json check_json(const atlas::AtlasCheckReport& report) {
@@ -235,6 +237,32 @@ nlohmann::json check_json(const atlas::AtlasCheckReport& report) {
                       {"volume_mm3", h.volume_mm3}});
   }
   json["meshes"] = meshes;
+  nlohmann::json anatomy;
+  nlohmann::json articulations = nlohmann::json::array();
+  for (const atlas::Articulation& a : report.anatomy.articulations) {
+    articulations.push_back({{"name", a.name},
+                             {"bones", {a.a, a.b}},
+                             {"gap_mm", a.gap_mm},
+                             {"overlap_mm", a.overlap_mm}});
+  }
+  anatomy["articulations"] = articulations;
+  nlohmann::json contacts = nlohmann::json::array();
+  for (const atlas::BoneContact& c : report.anatomy.contacts) {
+    contacts.push_back({{"bones", {c.a, c.b}},
+                        {"gap_mm", c.gap_mm},
+                        {"overlap_mm", c.overlap_mm},
+                        {"entering", c.entering}});
+  }
+  anatomy["bone_contacts"] = contacts;
+  nlohmann::json nearest = nlohmann::json::object();
+  for (const auto& [bone, gap] : report.anatomy.nearest_neighbour_gap_mm) {
+    nearest[bone] = std::isfinite(gap) ? nlohmann::json(gap) : nlohmann::json(nullptr);
+  }
+  anatomy["nearest_neighbour_gap_mm"] = nearest;
+  anatomy["hip_centre_offset_mm"] = report.anatomy.hip_centre_offset_mm >= 0
+                                        ? nlohmann::json(report.anatomy.hip_centre_offset_mm)
+                                        : nlohmann::json(nullptr);
+  json["anatomy"] = anatomy;
   return json;
 }
 
@@ -250,6 +278,28 @@ void print_check(const atlas::AtlasCheckReport& report) {
               << std::setprecision(1) << 100 * m.min_line_inside_fraction << "%" << std::setw(12)
               << 100 * m.min_inside_fraction << "%\n";
   }
+  std::cout << '\n'
+            << std::left << std::setw(22) << "articulation" << std::setw(40) << "bones"
+            << std::right << std::setw(10) << "gap mm" << std::setw(14) << "overlap mm" << '\n';
+  for (const atlas::Articulation& a : report.anatomy.articulations) {
+    std::cout << std::left << std::setw(22) << a.name << std::setw(40) << (a.a + " - " + a.b)
+              << std::right << std::setw(10) << std::setprecision(2) << a.gap_mm << std::setw(14)
+              << a.overlap_mm << '\n';
+  }
+  double deepest = 0.0;
+  std::string deepest_pair = "none";
+  for (const atlas::BoneContact& c : report.anatomy.contacts) {
+    if (c.overlap_mm > deepest) {
+      deepest = c.overlap_mm;
+      deepest_pair = c.entering + " in " + (c.entering == c.a ? c.b : c.a);
+    }
+  }
+  std::cout << "deepest bone in bone: " << std::setprecision(2) << deepest << " mm ("
+            << deepest_pair << ")\n";
+  if (report.anatomy.hip_centre_offset_mm >= 0) {
+    std::cout << "femoral head centre to acetabulum centre: " << std::setprecision(2)
+              << report.anatomy.hip_centre_offset_mm << " mm\n";
+  }
   std::cout << report.meshes.size() << " meshes checked\n";
   for (const std::string& problem : report.problems) std::cerr << "problem: " << problem << '\n';
   std::cout << (report.passed() ? "atlas check passed\n" : "atlas check FAILED\n");
@@ -259,6 +309,7 @@ void run_check(const CheckArgs& args) {
   atlas::AtlasCheckOptions options;
   options.max_penetration_mm = args.max_penetration_mm;
   options.min_inside_fraction = args.min_inside;
+  options.anatomy = args.anatomy;
   const atlas::AtlasCheckReport report = atlas::check_atlas(args.dir, options);
   if (args.json) {
     std::cout << check_json(report).dump(2) << '\n';
@@ -300,8 +351,9 @@ void register_atlas_commands(CLI::App& app) {
   auto check_args = std::make_shared<CheckArgs>();
   auto* check = atlas->add_subcommand(
       "check",
-      "Check an atlas: closed meshes, no muscle in bone, action lines inside muscles, "
-      "required landmarks; prints each muscle's volume and triangles");
+      "Check an atlas: closed meshes, no muscle in bone, action lines inside muscles, bones "
+      "that fit together (no overlap, no floating bone, closed joints, head in acetabulum), "
+      "required landmarks; prints each muscle's volume and triangles and each joint's gap");
   check->add_option("DIR", check_args->dir, "Atlas folder (holding atlas.yaml)")->required();
   check->add_flag("--json", check_args->json, "Print JSON instead of a table");
   check
@@ -313,6 +365,23 @@ void register_atlas_commands(CLI::App& app) {
                    "Least fraction of the fibre part (length less tendon) of each action line "
                    "inside its muscle")
       ->check(CLI::Range(0.0, 1.0));
+  check
+      ->add_option("--max-bone-overlap", check_args->anatomy.max_bone_overlap_mm,
+                   "Deepest vertex of a bone allowed inside another bone (mm)")
+      ->check(CLI::Range(0.0, 100.0));
+  check
+      ->add_option("--max-neighbour-gap", check_args->anatomy.max_neighbour_gap_mm,
+                   "Farthest a bone may be from its nearest neighbour (mm)")
+      ->check(CLI::Range(0.0, 100.0));
+  check
+      ->add_option("--max-joint-gap", check_args->anatomy.max_joint_gap_mm,
+                   "Widest gap allowed between the bones of a joint, and the patella and the "
+                   "femur (mm)")
+      ->check(CLI::Range(0.0, 100.0));
+  check
+      ->add_option("--max-hip-offset", check_args->anatomy.max_hip_centre_offset_mm,
+                   "Farthest the femoral head centre may be from the acetabulum's (mm)")
+      ->check(CLI::Range(0.0, 100.0));
   check->callback([check_args] { run_check(*check_args); });
 }
 

@@ -129,14 +129,19 @@ AtlasCheckReport check_atlas(const std::filesystem::path& dir, const AtlasCheckO
   for (const Bone& bone : atlas.bones) check_levels(dir, bone.name, bone.meshes, report);
   for (const Muscle& muscle : atlas.muscles) check_levels(dir, muscle.name, muscle.meshes, report);
 
-  // Bones' signed distances, built once.
-  std::map<std::string, std::unique_ptr<mesh::SignedDistance>> bones;
+  std::map<std::string, mesh::IndexedMesh> bone_surfaces;
   for (const Bone& bone : atlas.bones) {
     try {
-      bones[bone.name] = std::make_unique<mesh::SignedDistance>(load_mesh(dir, bone.meshes));
+      bone_surfaces[bone.name] = load_mesh(dir, bone.meshes);
     } catch (const std::exception&) {
       // Already reported by check_levels.
     }
+  }
+  report.anatomy = check_anatomy(atlas, bone_surfaces, options.anatomy, report.problems);
+  // Bones' signed distances, built once.
+  std::map<std::string, std::unique_ptr<mesh::SignedDistance>> bones;
+  for (const auto& [name, surface] : bone_surfaces) {
+    bones[name] = std::make_unique<mesh::SignedDistance>(surface);
   }
   for (const Muscle& muscle : atlas.muscles) {
     MuscleCheck check;

@@ -10,6 +10,9 @@
 //     less the muscle's tendon slack length (muscle surfaces end where the
 //     tendon begins: the iliotibial band of the tensor fasciae latae, the
 //     patellar tendon of the quadriceps);
+//   - the bones fit together as in a person (anatomy_check.h: no bone in
+//     another, none away from its neighbours, joints closed, the femoral
+//     head in the acetabulum);
 //   - the required landmarks exist (kRequiredLandmarks);
 //   - every reference resolves (read_atlas checks that; a failure is
 //     reported as a problem here rather than thrown).
@@ -21,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "core/atlas/anatomy_check.h"
 #include "core/atlas/atlas.h"
 
 namespace mmm::atlas {
@@ -29,6 +33,7 @@ struct AtlasCheckOptions {
   double max_penetration_mm = 1.0;   // deepest muscle vertex inside a bone
   double min_inside_fraction = 0.8;  // of each action line, inside its muscle
   double sample_step_mm = 1.0;       // spacing of action-line samples
+  AnatomyLimits anatomy;             // how the bones fit together (anatomy_check.h)
 };
 
 struct MeshHealth {
@@ -66,6 +71,7 @@ struct AtlasCheckReport {
   std::vector<MeshHealth> meshes;
   std::vector<MuscleCheck> muscles;
   std::vector<ActionLineCheck> action_lines;
+  AnatomyReport anatomy;
   std::vector<std::string> problems;  // one sentence each; empty when the atlas passes
 
   [[nodiscard]] bool passed() const { return problems.empty(); }

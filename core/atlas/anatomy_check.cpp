@@ -1,0 +1,158 @@
+#include "core/atlas/anatomy_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <sstream>
+
+namespace mmm::atlas {
+namespace {
+
+std::string mm_text(double value) {
+  std::ostringstream text;
+  text.setf(std::ios::fixed);
+  text.precision(2);
+  text << value << " mm";
+  return text.str();
+}
+
+bool tagged(const Bone& bone, const std::string& tag) {
+  return std::ranges::find(bone.tags, tag) != bone.tags.end();
+}
+
+// The bone a bone is welded to, followed to the one a real joint moves.
+std::string side_of(const Atlas& atlas, const std::string& bone_name) {
+  std::string current = bone_name;
+  for (std::size_t guard = 0; guard <= atlas.bones.size(); ++guard) {
+    const Bone* bone = atlas.find_bone(current);
+    if (bone == nullptr || bone->parent_joint.empty()) return current;
+    const Joint* joint = atlas.find_joint(bone->parent_joint);
+    if (joint == nullptr || joint->type != JointType::kWeld) return current;
+    current = joint->parent;
+  }
+  return current;
+}
+
+const BoneContact* find_contact(const std::vector<BoneContact>& contacts, const std::string& a,
+                                const std::string& b) {
+  for (const BoneContact& contact : contacts) {
+    if ((contact.a == a && contact.b == b) || (contact.a == b && contact.b == a)) return &contact;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+AnatomyReport check_anatomy(const Atlas& atlas,
+                            const std::map<std::string, mesh::IndexedMesh>& bones,
+                            const AnatomyLimits& limits, std::vector<std::string>& problems) {
+  AnatomyReport report;
+  std::vector<NamedSurface> surfaces;
+  for (const Bone& bone : atlas.bones) {
+    const auto it = bones.find(bone.name);
+    if (it != bones.end()) surfaces.push_back({bone.name, &it->second});
+  }
+  const double reach = std::max(limits.max_neighbour_gap_mm, limits.max_joint_gap_mm) + 5.0;
+  report.contacts = bone_contacts(surfaces, reach);
+
+  for (const BoneContact& contact : report.contacts) {
+    if (contact.overlap_mm > limits.max_bone_overlap_mm) {
+      const std::string& other = contact.entering == contact.a ? contact.b : contact.a;
+      problems.push_back("bone " + contact.entering + " enters " + other + " by " +
+                         mm_text(contact.overlap_mm) + " (at most " +
+                         mm_text(limits.max_bone_overlap_mm) + " allowed)");
+    }
+  }
+  for (const NamedSurface& bone : surfaces) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const BoneContact& contact : report.contacts) {
+      if (contact.a == bone.name || contact.b == bone.name) {
+        nearest = std::min(nearest, contact.gap_mm);
+      }
+    }
+    if (!std::isfinite(nearest)) {
+      // Beyond the reach of the contacts: measured against every bone.
+      for (const NamedSurface& other : surfaces) {
+        if (other.name != bone.name)
+          nearest = std::min(nearest, contact_between(bone, other).gap_mm);
+      }
+    }
+    report.nearest_neighbour_gap_mm[bone.name] = nearest;
+    if (surfaces.size() > 1 && nearest > limits.max_neighbour_gap_mm) {
+      problems.push_back("bone " + bone.name + " is " + mm_text(nearest) +
+                         " from its nearest neighbour (at most " +
+                         mm_text(limits.max_neighbour_gap_mm) + " allowed)");
+    }
+  }
+
+  const auto add_articulation = [&](const std::string& name, const std::set<std::string>& one,
+                                    const std::set<std::string>& other) {
+    Articulation best{name, "", "", std::numeric_limits<double>::infinity(), 0.0};
+    for (const std::string& a : one) {
+      for (const std::string& b : other) {
+        const BoneContact* contact = find_contact(report.contacts, a, b);
+        if (contact != nullptr && contact->gap_mm < best.gap_mm) {
+          best = {name, a, b, contact->gap_mm, contact->overlap_mm};
+        }
+      }
+    }
+    if (best.a.empty()) {
+      // Beyond the reach of the contacts: measured pair by pair.
+      for (const std::string& a : one) {
+        for (const std::string& b : other) {
+          const BoneContact contact = contact_between({a, &bones.at(a)}, {b, &bones.at(b)});
+          if (best.a.empty() || contact.gap_mm < best.gap_mm) {
+            best = {name, a, b, contact.gap_mm, contact.overlap_mm};
+          }
+        }
+      }
+    }
+    if (best.gap_mm > limits.max_joint_gap_mm) {
+      problems.push_back("articulation " + name + ": " + best.a + " and " + best.b + " are " +
+                         mm_text(best.gap_mm) + " apart (at most " +
+                         mm_text(limits.max_joint_gap_mm) + " allowed)");
+    }
+    report.articulations.push_back(best);
+  };
+  const auto members = [&](const std::string& side) {
+    std::set<std::string> names;
+    for (const NamedSurface& bone : surfaces) {
+      if (side_of(atlas, bone.name) == side && !tagged(*atlas.find_bone(bone.name), "patella")) {
+        names.insert(bone.name);
+      }
+    }
+    return names;
+  };
+  for (const Joint& joint : atlas.joints) {
+    if (joint.type == JointType::kWeld) continue;
+    const std::set<std::string> parent = members(side_of(atlas, joint.parent));
+    const std::set<std::string> child = members(side_of(atlas, joint.child));
+    if (parent.empty() || child.empty()) continue;
+    add_articulation(joint.name, parent, child);
+  }
+  for (const Bone& patella : atlas.bones) {
+    if (!tagged(patella, "patella") || !bones.contains(patella.name)) continue;
+    std::set<std::string> femurs;
+    for (const Bone& bone : atlas.bones) {
+      if (tagged(bone, "femur") && bones.contains(bone.name)) femurs.insert(bone.name);
+    }
+    if (femurs.empty()) continue;
+    const std::string side = patella.name.ends_with("_l") ? "_l" : "_r";
+    add_articulation("patellofemoral" + side, {patella.name}, femurs);
+  }
+
+  const Landmark* head = atlas.find_landmark("femoral_head_centre_r");
+  const Landmark* socket = atlas.find_landmark("acetabulum_centre_r");
+  if (head != nullptr && socket != nullptr) {
+    report.hip_centre_offset_mm = (head->position - socket->position).norm();
+    if (report.hip_centre_offset_mm > limits.max_hip_centre_offset_mm) {
+      problems.push_back("the femoral head is " + mm_text(report.hip_centre_offset_mm) +
+                         " from the centre of the acetabulum (at most " +
+                         mm_text(limits.max_hip_centre_offset_mm) + " allowed)");
+    }
+  }
+  return report;
+}
+
+}  // namespace mmm::atlas
