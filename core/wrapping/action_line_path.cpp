@@ -1,5 +1,8 @@
 #include "core/wrapping/action_line_path.h"
 
+#include <algorithm>
+#include <array>
+
 #include "core/errors.h"
 
 namespace mmm::wrapping {
@@ -50,6 +53,22 @@ Obstacle posed_obstacle(const atlas::WrapObstacle& source, const motion::Skeleto
   return obstacle;
 }
 
+// Smoothstep from 0 at an end of the range to 1 at `blend` inside it.
+double conditional_weight(double value, const std::array<double, 2>& range, double blend) {
+  const double width = std::min(blend, 0.5 * (range[1] - range[0]));
+  if (!(width > 0)) return 1.0;
+  const double t = std::clamp(std::min(value - range[0], range[1] - value) / width, 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
+}
+
+Eigen::Vector3d closest_on_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                   const Eigen::Vector3d& p) {
+  const Eigen::Vector3d ab = b - a;
+  const double squared = ab.squaredNorm();
+  if (squared <= 0) return a;
+  return a + std::clamp((p - a).dot(ab) / squared, 0.0, 1.0) * ab;
+}
+
 }  // namespace
 
 ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& muscle,
@@ -60,12 +79,15 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
   pose.set(q);
   std::vector<Eigen::Vector3d> anchors;
   std::vector<std::string> anchor_bones;
+  std::vector<double> weights;  // 1 but for conditional points fading in
   ActionLinePath path;
   for (const atlas::PathPoint& point : line.points) {
     const int body = body_of(skeleton, point.bone, what + " point " + point.name);
+    double weight = 1.0;
     if (point.kind == atlas::PathPointKind::kConditional) {
       const double value = coordinate_value(skeleton, q, point.coordinate, what);
       if (value < point.range[0] || value > point.range[1]) continue;
+      weight = conditional_weight(value, point.range, options.conditional_blend);
     }
     Eigen::Vector3d local = point.position;
     if (point.kind == atlas::PathPointKind::kMoving) {
@@ -79,10 +101,19 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
     }
     anchors.push_back(pose.point(body, local));
     anchor_bones.push_back(point.bone);
+    weights.push_back(weight);
     path.active.push_back(point.name);
   }
   if (anchors.size() < 2) {
     throw InvalidInputError(what + ": fewer than 2 path points are active at this pose");
+  }
+  // A fading conditional point moves from the segment between its
+  // neighbours (weight 0) to its own place (weight 1).
+  for (std::size_t i = 1; i + 1 < anchors.size(); ++i) {
+    if (weights[i] >= 1.0) continue;
+    const Eigen::Vector3d on_segment =
+        closest_on_segment(anchors[i - 1], anchors[i + 1], anchors[i]);
+    anchors[i] = on_segment + weights[i] * (anchors[i] - on_segment);
   }
   std::vector<Obstacle> obstacles;
   std::vector<std::string> obstacle_bones;

@@ -7,8 +7,9 @@
 // through (obstacle_set.h; obstacles ride on their bones too).
 //
 // Moment arm about a coordinate, OpenSim's convention: r = -dL/dq (mm per
-// rad), by central differences of the path length (the path's kinks at
-// conditional points make it piecewise smooth, as in OpenSim).
+// rad), by central differences of the path length. Conditional points fade
+// in and out (PathOptions::conditional_blend), so length and moment arm stay
+// continuous where OpenSim's path jumps.
 
 #include <Eigen/Core>
 #include <string>
@@ -35,6 +36,13 @@ struct ActionLinePath {
 struct PathOptions {
   WrapOptions wrap;
   double derivative_step = 1e-4;  // rad (or mm) for the moment arms' central differences
+  // A conditional point fades in over this much of its coordinate (rad, or
+  // mm) inside each end of its range: at the end of the range it lies on the
+  // segment between its neighbours, so switching it on or off changes
+  // neither the length nor the moment arm (smoothstep weight). At most half
+  // the range. 0: OpenSim's abrupt switch (a jump in length, and a spike in
+  // the moment arm, wherever the point is off the line when it switches).
+  double conditional_blend = 0.17453292519943295;  // 10 deg
 };
 
 // `skeleton` must be built from `atlas` (motion::skeleton_from_atlas), or
