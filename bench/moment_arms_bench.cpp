@@ -49,15 +49,6 @@ const SweepModels& sweep_models() {
     const char* dir = std::getenv("MMM_BENCH_ATLAS");
     m.atlas = mmm::atlas::read_atlas(dir != nullptr ? dir : "build/atlas/vhf_right_leg");
     m.atlas_skeleton = mmm::motion::skeleton_from_atlas(m.atlas);
-    if (std::getenv("MMM_BENCH_NO_FIT_POINTS") != nullptr) {
-      for (mmm::atlas::Muscle& muscle : m.atlas.muscles) {
-        for (mmm::atlas::ActionLine& line : muscle.action_lines) {
-          std::erase_if(line.points, [](const mmm::atlas::PathPoint& p) {
-            return p.name.find("-fit") != std::string::npos;
-          });
-        }
-      }
-    }
     const mmm::opensim::OsimModel model = mmm::opensim::read_osim(
         std::filesystem::path(MMM_DATA_DIR) / "gait2392" / "gait2392_thelen2003muscle.osim");
     m.gait2392 = wrapping::osim_action_lines(model);

@@ -271,6 +271,7 @@ std::vector<ActionLineFitReport> fit_action_lines(
               return bone_tree(bone).closest_point(*centre).squared_distance;
             });
             added.position = *centre;
+            added.kind = PathPointKind::kFollowsLine;
             refined.push_back(std::move(added));
             ++report.points_added;
             split = true;

@@ -88,7 +88,12 @@ struct Joint {
   std::vector<TransformAxis> axes;  // kCustom: 6 (rotation1..3, translation1..3)
 };
 
-enum class PathPointKind { kFixed, kConditional, kMoving };
+// kFollowsLine: a point added by the atlas build to keep the line inside its
+// muscle; it keeps its rest place relative to the segment between the
+// nearest other active points before and after it (fraction along it,
+// offset turned with it), so it bends the line without changing how the
+// line's length depends on the joints (wrapping/action_line_path.h).
+enum class PathPointKind { kFixed, kConditional, kMoving, kFollowsLine };
 
 struct PathPoint {
   std::string name;

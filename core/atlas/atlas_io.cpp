@@ -69,7 +69,8 @@ const NameTable<CoordinateKind>& coordinate_kinds() {
 const NameTable<PathPointKind>& path_point_kinds() {
   static const NameTable<PathPointKind> table = {{PathPointKind::kFixed, "fixed"},
                                                  {PathPointKind::kConditional, "conditional"},
-                                                 {PathPointKind::kMoving, "moving"}};
+                                                 {PathPointKind::kMoving, "moving"},
+                                                 {PathPointKind::kFollowsLine, "follows_line"}};
   return table;
 }
 

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cstddef>
+
+#include <Eigen/Geometry>
 
 #include "core/errors.h"
 
@@ -69,6 +72,21 @@ Eigen::Vector3d closest_on_segment(const Eigen::Vector3d& a, const Eigen::Vector
   return a + std::clamp((p - a).dot(ab) / squared, 0.0, 1.0) * ab;
 }
 
+// Where a point at `rest` relative to the rest segment a0-b0 lies relative to
+// the segment a-b: same fraction along it, offset turned by the rotation
+// taking the rest direction to the current one.
+Eigen::Vector3d follow_segment(const Eigen::Vector3d& a0, const Eigen::Vector3d& b0,
+                               const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& rest) {
+  const Eigen::Vector3d d0 = b0 - a0;
+  const Eigen::Vector3d d = b - a;
+  if (d0.squaredNorm() <= 0 || d.squaredNorm() <= 0) return a + (rest - a0);
+  const double t = (rest - a0).dot(d0) / d0.squaredNorm();
+  const Eigen::Vector3d offset = rest - (a0 + t * d0);
+  const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(d0, d);
+  return a + t * d + turn * offset;
+}
+
 }  // namespace
 
 ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& muscle,
@@ -77,17 +95,31 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
   const std::string what = "action line " + line.name;
   motion::SkeletonPose pose(skeleton);
   pose.set(q);
-  std::vector<Eigen::Vector3d> anchors;
-  std::vector<std::string> anchor_bones;
-  std::vector<double> weights;  // 1 but for conditional points fading in
-  ActionLinePath path;
+  // Every point in order: where it is now and where it was at rest; an
+  // inactive conditional point still has a place (its followers use it).
+  struct Placed {
+    Eigen::Vector3d now = Eigen::Vector3d::Zero();
+    Eigen::Vector3d rest = Eigen::Vector3d::Zero();
+    int body = 0;
+    double weight = 1.0;  // < 1: a conditional point fading in
+    bool follows = false;
+    bool active = true;
+  };
+  std::vector<Placed> placed;
+  placed.reserve(line.points.size());
   for (const atlas::PathPoint& point : line.points) {
-    const int body = body_of(skeleton, point.bone, what + " point " + point.name);
-    double weight = 1.0;
+    Placed p;
+    p.rest = point.position;
+    p.body = body_of(skeleton, point.bone, what + " point " + point.name);
+    if (point.kind == atlas::PathPointKind::kFollowsLine) {
+      p.follows = true;
+      placed.push_back(p);
+      continue;
+    }
     if (point.kind == atlas::PathPointKind::kConditional) {
       const double value = coordinate_value(skeleton, q, point.coordinate, what);
-      if (value < point.range[0] || value > point.range[1]) continue;
-      weight = conditional_weight(value, point.range, options.conditional_blend);
+      p.active = value >= point.range[0] && value <= point.range[1];
+      if (p.active) p.weight = conditional_weight(value, point.range, options.conditional_blend);
     }
     Eigen::Vector3d local = point.position;
     if (point.kind == atlas::PathPointKind::kMoving) {
@@ -99,21 +131,78 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
       }
       local = (bone != nullptr ? bone->frame : Eigen::Isometry3d::Identity()) * in_bone;
     }
-    anchors.push_back(pose.point(body, local));
-    anchor_bones.push_back(point.bone);
-    weights.push_back(weight);
-    path.active.push_back(point.name);
+    p.now = pose.point(p.body, local);
+    placed.push_back(p);
+  }
+  // Followers keep their rest place relative to the segment between the
+  // nearest always-active points around them (not conditional ones: their
+  // segments may be short and switch): the fraction along it, and the
+  // offset from it turned with it. Without such a point on one side, their
+  // bone carries them.
+  const auto fixed_neighbour = [&](std::size_t i, int step) {
+    for (auto j = static_cast<std::ptrdiff_t>(i) + step;
+         j >= 0 && j < static_cast<std::ptrdiff_t>(placed.size()); j += step) {
+      const auto k = static_cast<std::size_t>(j);
+      if (!placed[k].follows && line.points[k].kind != atlas::PathPointKind::kConditional) {
+        return j;
+      }
+    }
+    return std::ptrdiff_t{-1};
+  };
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    if (!placed[i].follows) continue;
+    const std::ptrdiff_t before = fixed_neighbour(i, -1);
+    const std::ptrdiff_t after = fixed_neighbour(i, +1);
+    if (before < 0 || after < 0) {
+      placed[i].now = pose.point(placed[i].body, placed[i].rest);
+      continue;
+    }
+    const Placed& a = placed[static_cast<std::size_t>(before)];
+    const Placed& b = placed[static_cast<std::size_t>(after)];
+    placed[i].now = follow_segment(a.rest, b.rest, a.now, b.now, placed[i].rest);
+  }
+  // A fading conditional point moves from the segment between the active
+  // points next to it (weight 0: the path is as without it) to its own place
+  // (weight 1). Its neighbours differ between the drawn path (followers
+  // included) and the line of action (without them): one place for each.
+  const auto faded = [&](bool with_followers) {
+    std::vector<Eigen::Vector3d> places;
+    for (const Placed& p : placed) places.push_back(p.now);
+    const auto counts = [&](std::size_t j) {
+      return placed[j].active && (with_followers || !placed[j].follows);
+    };
+    const auto next_counted = [&](std::size_t i, int step) {
+      for (auto j = static_cast<std::ptrdiff_t>(i) + step;
+           j >= 0 && j < static_cast<std::ptrdiff_t>(placed.size()); j += step) {
+        if (counts(static_cast<std::size_t>(j))) return j;
+      }
+      return std::ptrdiff_t{-1};
+    };
+    for (std::size_t i = 0; i < placed.size(); ++i) {
+      if (!placed[i].active || placed[i].follows || placed[i].weight >= 1.0) continue;
+      const std::ptrdiff_t before = next_counted(i, -1);
+      const std::ptrdiff_t after = next_counted(i, +1);
+      if (before < 0 || after < 0) continue;
+      const Eigen::Vector3d on_segment =
+          closest_on_segment(placed[static_cast<std::size_t>(before)].now,
+                             placed[static_cast<std::size_t>(after)].now, placed[i].now);
+      places[i] = on_segment + placed[i].weight * (placed[i].now - on_segment);
+    }
+    return places;
+  };
+  const std::vector<Eigen::Vector3d> drawn = faded(true);
+  const std::vector<Eigen::Vector3d> of_action = faded(false);
+  ActionLinePath path;
+  std::vector<Eigen::Vector3d> anchors;
+  std::vector<std::string> anchor_bones;
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    if (!placed[i].active) continue;
+    anchors.push_back(drawn[i]);
+    anchor_bones.push_back(line.points[i].bone);
+    path.active.push_back(line.points[i].name);
   }
   if (anchors.size() < 2) {
     throw InvalidInputError(what + ": fewer than 2 path points are active at this pose");
-  }
-  // A fading conditional point moves from the segment between its
-  // neighbours (weight 0) to its own place (weight 1).
-  for (std::size_t i = 1; i + 1 < anchors.size(); ++i) {
-    if (weights[i] >= 1.0) continue;
-    const Eigen::Vector3d on_segment =
-        closest_on_segment(anchors[i - 1], anchors[i + 1], anchors[i]);
-    anchors[i] = on_segment + weights[i] * (anchors[i] - on_segment);
   }
   std::vector<Obstacle> obstacles;
   std::vector<std::string> obstacle_bones;
@@ -126,31 +215,50 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
     obstacles.push_back(posed_obstacle(*found, pose, skeleton, what));
     obstacle_bones.push_back(found->bone);
   }
+  // The first listed obstacle the segment a-b would pass through, or the
+  // straight segment.
+  const auto wrapped = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                           std::string& wrapped_on) {
+    WrapResult chosen;
+    chosen.points = {a, b};
+    chosen.length = (b - a).norm();
+    for (std::size_t o = 0; o < obstacles.size(); ++o) {
+      const WrapResult wrap = wrap_segment(a, b, obstacles[o], options.wrap);
+      path.inside_obstacle = path.inside_obstacle || wrap.inside;
+      if (wrap.wrapped) {
+        wrapped_on = obstacle_bones[o];
+        return wrap;
+      }
+    }
+    return chosen;
+  };
   path.points.push_back(anchors.front());
   path.point_bones.push_back(anchor_bones.front());
   path.point_names.push_back(path.active.front());
   for (std::size_t i = 1; i < anchors.size(); ++i) {
-    // The first listed obstacle this segment would pass through.
-    WrapResult chosen;
-    chosen.points = {anchors[i - 1], anchors[i]};
-    chosen.length = (anchors[i] - anchors[i - 1]).norm();
     std::string wrapped_on;
-    for (std::size_t o = 0; o < obstacles.size(); ++o) {
-      const WrapResult wrap = wrap_segment(anchors[i - 1], anchors[i], obstacles[o], options.wrap);
-      path.inside_obstacle = path.inside_obstacle || wrap.inside;
-      if (wrap.wrapped) {
-        chosen = wrap;
-        wrapped_on = obstacle_bones[o];
-        ++path.wraps;
-        break;
-      }
-    }
+    const WrapResult chosen = wrapped(anchors[i - 1], anchors[i], wrapped_on);
+    if (chosen.wrapped) ++path.wraps;
     path.points.insert(path.points.end(), chosen.points.begin() + 1, chosen.points.end());
     path.point_bones.insert(path.point_bones.end(), chosen.points.size() - 2, wrapped_on);
     path.point_bones.push_back(anchor_bones[i]);
     path.point_names.insert(path.point_names.end(), chosen.points.size() - 2, std::string());
     path.point_names.push_back(path.active[i]);
     path.length += chosen.length;
+  }
+  // The length (and so the moment arms) is the line of action's: the
+  // model's points and their wraps, without the followers, which only bend
+  // the drawn path through the muscle.
+  std::vector<Eigen::Vector3d> mechanical;
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    if (placed[i].active && !placed[i].follows) mechanical.push_back(of_action[i]);
+  }
+  if (mechanical.size() != anchors.size()) {
+    path.length = 0.0;
+    for (std::size_t i = 1; i < mechanical.size(); ++i) {
+      std::string ignored;
+      path.length += wrapped(mechanical[i - 1], mechanical[i], ignored).length;
+    }
   }
   return path;
 }

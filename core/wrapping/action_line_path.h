@@ -28,7 +28,10 @@ struct ActionLinePath {
   // carrying it (on a wrap: the obstacle's bone).
   std::vector<std::string> point_names;
   std::vector<std::string> point_bones;
-  double length = 0.0;           // mm
+  // mm: of the line of action, the model's points and their wraps; points
+  // that follow the line (kFollowsLine) bend `points` through the muscle but
+  // do not count here, nor in the moment arms.
+  double length = 0.0;
   int wraps = 0;                 // segments that wrapped over an obstacle
   bool inside_obstacle = false;  // a path point lies inside an obstacle
 };

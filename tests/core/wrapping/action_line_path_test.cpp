@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <numbers>
 
 #include "core/errors.h"
@@ -93,6 +94,51 @@ TEST(ActionLinePathTest, UnknownObstaclesAndDegenerateEllipsoidsAreErrors) {
                InvalidInputError);
   muscle.wrap_obstacles.front().radii = Eigen::Vector3d(20, 15, 10);  // a proper ellipsoid
   EXPECT_NO_THROW(action_line_path(leg.atlas, muscle, muscle.action_lines.front(), skeleton, q));
+}
+
+}  // namespace
+}  // namespace mmm::wrapping
+
+namespace mmm::wrapping {
+namespace {
+
+// A point added by the atlas build to keep a line inside its muscle follows
+// the segment between the line's other points: same fraction along it, its
+// offset turned with it. It bends the drawn path through the muscle; the
+// length and the moment arms stay the line of action's.
+TEST(ActionLinePathTest, AFollowerKeepsItsPlaceRelativeToTheSegmentAroundIt) {
+  test::ToyLeg leg = test::toy_leg();
+  atlas::Muscle& muscle = leg.atlas.muscles.front();
+  atlas::ActionLine& line = muscle.action_lines.front();
+  line.wrap_obstacles.clear();
+  const Vector3d a0 = line.points.front().position;
+  const Vector3d b0 = line.points.back().position;
+  const Vector3d offset0 = (b0 - a0).cross(Vector3d::UnitX()).normalized() * 12.0;
+  atlas::PathPoint follower;
+  follower.name = "fit1";
+  follower.bone = "femur_r";
+  follower.kind = atlas::PathPointKind::kFollowsLine;
+  follower.position = a0 + 0.4 * (b0 - a0) + offset0;
+  line.points.insert(line.points.begin() + 1, follower);
+  const motion::Skeleton skeleton = motion::skeleton_from_atlas(leg.atlas);
+  const int knee = *skeleton.coordinate_index("knee_angle_r");
+  for (const double angle : {0.0, 0.4, -0.6}) {
+    Eigen::VectorXd q = skeleton.default_coordinates();
+    q(knee) = angle;
+    const ActionLinePath path = action_line_path(leg.atlas, muscle, line, skeleton, q);
+    ASSERT_EQ(path.points.size(), 3U);
+    const Vector3d a = path.points[0];
+    const Vector3d b = path.points[2];
+    const Vector3d expected =
+        a + 0.4 * (b - a) + Eigen::Quaterniond::FromTwoVectors(b0 - a0, b - a) * offset0;
+    EXPECT_NEAR((path.points[1] - expected).norm(), 0.0, 1e-9) << angle;
+    EXPECT_NEAR(path.length, (b - a).norm(), 1e-9) << angle;
+    atlas::ActionLine straight = line;
+    straight.points.erase(straight.points.begin() + 1);
+    EXPECT_NEAR(moment_arm(leg.atlas, muscle, line, skeleton, q, knee),
+                moment_arm(leg.atlas, muscle, straight, skeleton, q, knee), 1e-9)
+        << angle;
+  }
 }
 
 }  // namespace
