@@ -72,12 +72,24 @@ void AtlasCliTest::check_passes() {
   ASSERT_EQ(check.exit_code, 0) << check.out << check.err;
   const nlohmann::json report = nlohmann::json::parse(check.out);
   EXPECT_TRUE(report["passed"].get<bool>());
-  EXPECT_EQ(report["muscles"].size(), 21U);
+  EXPECT_EQ(report["muscles"].size(), 38U);  // 37 right muscles + the mirrored left one
   for (const auto& muscle : report["muscles"]) {
     // The builder cleans muscles down to 0.5 mm inside bone; the check allows 1.
     EXPECT_LE(muscle["max_penetration_mm"].get<double>(), 1.0) << muscle["name"];
-    EXPECT_GT(muscle["volume_mm3"].get<double>(), 1e4) << muscle["name"];
+    // The gemelli and plantaris are the smallest (2.3-3.8 cm^3).
+    EXPECT_GT(muscle["volume_mm3"].get<double>(), 2e3) << muscle["name"];
   }
+  // One subject's bones fit together: every joint closed, no bone in another.
+  const nlohmann::json& anatomy = report["anatomy"];
+  ASSERT_GE(anatomy["articulations"].size(), 6U);
+  for (const auto& articulation : anatomy["articulations"]) {
+    EXPECT_LE(articulation["gap_mm"].get<double>(), 3.0) << articulation["name"];
+    EXPECT_LE(articulation["overlap_mm"].get<double>(), 1.0) << articulation["name"];
+  }
+  for (const auto& [bone, gap] : anatomy["nearest_neighbour_gap_mm"].items()) {
+    EXPECT_LE(gap.get<double>(), 5.0) << bone;
+  }
+  EXPECT_LT(anatomy["hip_centre_offset_mm"].get<double>(), 3.0);
   const atlas::Atlas atlas = atlas::read_atlas(atlas_);
   for (const char* name : {"femoral_head_centre_r", "patella_centre_r", "ankle_centre_r", "asis_r",
                            "lateral_epicondyle_r", "medial_malleolus_r"}) {

@@ -195,7 +195,7 @@ TEST(AtlasSchemaTest, StructuralMistakesAreRejected) {
   EXPECT_THAT(violations_of(replaced(manifest, "kind: conditional, coordinate: knee_angle_r",
                                      "kind: conditional")),
               ::testing::ElementsAre(HasSubstr("muscles[0].action_lines[0].points[1]: matches "
-                                               "none of the 3 alternatives")));
+                                               "none of the 4 alternatives")));
   // A function of an unknown kind.
   EXPECT_THAT(violations_of(replaced(manifest, "kind: constant", "kind: konstant")),
               ::testing::ElementsAre(HasSubstr("joints[1].axes[1].function: matches none of "
