@@ -520,10 +520,13 @@ void Builder::build_muscles() {
       // length, the rest of the line the tendon.
       muscle.optimal_fibre_length_mm = line.belly_mm;
       muscle.tendon_slack_length_mm = line.tendon_mm;
-      report_.notes.push_back(recipe_muscle.name +
-                              ": no OpenSim path; its action line runs between its contacts with " +
-                              origin + " and " + insertion +
-                              " (fibre and tendon lengths from its surface; no force)");
+      std::string note = recipe_muscle.name;
+      note.append(": no OpenSim path; its action line runs between its contacts with ")
+          .append(origin)
+          .append(" and ")
+          .append(insertion)
+          .append(" (fibre and tendon lengths from its surface; no force)");
+      report_.notes.push_back(std::move(note));
     }
     if (const auto lines = static_cast<double>(recipe_muscle.action_lines.size());
         lines > 0 && recipe_muscle.surface_line.empty()) {

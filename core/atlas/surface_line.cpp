@@ -44,7 +44,7 @@ Eigen::Vector3d contact_middle(const mesh::IndexedMesh& muscle, const mesh::Aabb
 Eigen::Vector3d inside_point(const Eigen::Vector3d& centre, const mesh::AabbTree& tree,
                              const mesh::WindingNumber& winding) {
   if (winding.is_inside(centre)) return centre;
-  const Eigen::Vector3d nearest = tree.closest_point(centre).point;
+  Eigen::Vector3d nearest = tree.closest_point(centre).point;
   const Eigen::Vector3d towards = nearest - centre;
   if (towards.norm() < 1e-9) return centre;
   const std::vector<mesh::AabbTree::RayHit> hits = tree.all_hits(centre, towards.normalized());

@@ -167,6 +167,7 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
   // included) and the line of action (without them): one place for each.
   const auto faded = [&](bool with_followers) {
     std::vector<Eigen::Vector3d> places;
+    places.reserve(placed.size());
     for (const Placed& p : placed) places.push_back(p.now);
     const auto counts = [&](std::size_t j) {
       return placed[j].active && (with_followers || !placed[j].follows);
@@ -223,7 +224,7 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
     chosen.points = {a, b};
     chosen.length = (b - a).norm();
     for (std::size_t o = 0; o < obstacles.size(); ++o) {
-      const WrapResult wrap = wrap_segment(a, b, obstacles[o], options.wrap);
+      WrapResult wrap = wrap_segment(a, b, obstacles[o], options.wrap);
       path.inside_obstacle = path.inside_obstacle || wrap.inside;
       if (wrap.wrapped) {
         wrapped_on = obstacle_bones[o];
