@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_main.h"
 #include "core/atlas/atlas_io.h"
 #include "core/fibres/fibre_quality.h"
 #include "core/fibres/muscle_fibres.h"
@@ -265,14 +266,5 @@ BENCHMARK_CAPTURE(BM_Decompose, iliacus_mass_spring, "iliacus_r", DecompositionM
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    benchmark::Initialize(&argc, argv);
-    if (std::getenv("MMM_BENCH_SKIP_ACCURACY") == nullptr) write_accuracy_table();
-    benchmark::RunSpecifiedBenchmarks();
-    benchmark::Shutdown();
-  } catch (const std::exception& error) {
-    std::cerr << "mmm_bench_fibres: " << error.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return mmm::bench::run_suite(argc, argv, "mmm_bench_fibres", write_accuracy_table);
 }

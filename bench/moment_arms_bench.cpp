@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_main.h"
 #include "core/atlas/atlas_io.h"
 #include "core/motion/skeleton.h"
 #include "core/opensim/osim_model.h"
@@ -220,14 +221,5 @@ BENCHMARK(BM_HipFlexionSweepOfEveryLine)->Unit(benchmark::kMillisecond);
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    benchmark::Initialize(&argc, argv);
-    if (std::getenv("MMM_BENCH_SKIP_ACCURACY") == nullptr) write_accuracy_table();
-    benchmark::RunSpecifiedBenchmarks();
-    benchmark::Shutdown();
-  } catch (const std::exception& error) {
-    std::cerr << "mmm_bench_moment_arms: " << error.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return mmm::bench::run_suite(argc, argv, "mmm_bench_moment_arms", write_accuracy_table);
 }

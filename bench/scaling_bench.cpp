@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_main.h"
 #include "core/atlas/atlas_io.h"
 #include "core/atlas/atlas_meshes.h"
 #include "core/atlas/patient_deformation.h"
@@ -449,14 +450,5 @@ BENCHMARK(BM_ScaleWholeAtlasBony)->Unit(benchmark::kMillisecond)->Iterations(1);
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    benchmark::Initialize(&argc, argv);
-    if (std::getenv("MMM_BENCH_SKIP_ACCURACY") == nullptr) write_accuracy_table();
-    benchmark::RunSpecifiedBenchmarks();
-    benchmark::Shutdown();
-  } catch (const std::exception& error) {
-    std::cerr << "mmm_bench_scaling: " << error.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return mmm::bench::run_suite(argc, argv, "mmm_bench_scaling", write_accuracy_table);
 }

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include <algorithm>
+#include "bench/bench_main.h"
 #include "core/atlas/atlas_io.h"
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/signed_distance.h"
@@ -477,14 +478,5 @@ BENCHMARK(BM_GluteusMaximusTenFrames)->Unit(benchmark::kMillisecond);
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    benchmark::Initialize(&argc, argv);
-    if (std::getenv("MMM_BENCH_SKIP_ACCURACY") == nullptr) write_accuracy_table();
-    benchmark::RunSpecifiedBenchmarks();
-    benchmark::Shutdown();
-  } catch (const std::exception& error) {
-    std::cerr << "mmm_bench_wrapping: " << error.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return mmm::bench::run_suite(argc, argv, "mmm_bench_wrapping", write_accuracy_table);
 }
