@@ -1,5 +1,6 @@
 #include "core/wrapping/line_router.h"
 
+#include <set>
 #include <string>
 #include <utility>
 
@@ -32,13 +33,19 @@ ActionLinePath LineRouter::global_route(const Eigen::VectorXd& q, const GlobalPa
                                         GlobalPath* result) const {
   // The path points in this pose (the obstacle-set path's named points;
   // its wraps are dropped: the bones themselves are the obstacles here).
+  // Points that only follow the line (kFollowsLine) are left out: the
+  // global path is the line of action itself.
   const ActionLinePath straight =
       action_line_path(atlas_, muscle_, line_, skeleton_, q, options_.path);
+  std::set<std::string> followers;
+  for (const atlas::PathPoint& point : line_.points) {
+    if (point.kind == atlas::PathPointKind::kFollowsLine) followers.insert(point.name);
+  }
   std::vector<Eigen::Vector3d> fixed;
   std::vector<std::string> names;
   std::vector<std::string> bones;
   for (std::size_t i = 0; i < straight.points.size(); ++i) {
-    if (straight.point_names[i].empty()) continue;
+    if (straight.point_names[i].empty() || followers.contains(straight.point_names[i])) continue;
     fixed.push_back(straight.points[i]);
     names.push_back(straight.point_names[i]);
     bones.push_back(straight.point_bones[i]);
