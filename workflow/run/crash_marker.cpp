@@ -93,7 +93,12 @@ void on_crash(int signal, siginfo_t* info, void* /*context*/) {
   // A fault of this process (si_code > 0: raised by the kernel) or raise()/
   // abort() in it; a signal sent by another process is not a node's crash.
   const bool raised_here = info == nullptr || info->si_code > 0 || info->si_pid == ::getpid();
-  if (raised_here && t_marker_path != nullptr) append_marker(signal);
+  if (raised_here && t_marker_path != nullptr) {
+    append_marker(signal);
+    // Once per crash: the handler found before may end the process with a
+    // second signal on this thread (a sanitizer's report then abort()).
+    t_marker_path = nullptr;
+  }
   // Hand over to the handler found before. A fault returns to the faulting
   // instruction, which faults again into it; a sent or raised signal is
   // raised again (blocked until this handler returns).
