@@ -91,3 +91,21 @@ TEST(BoundedYamlTest, AFileIsCheckedForSizeBeforeItIsRead) {
 
 }  // namespace
 }  // namespace mmm
+
+namespace mmm {
+namespace {
+
+TEST(BoundedYamlTest, ANulByteIsRefusedWithItsLineBeforeParsing) {
+  const std::string text = std::string("a: 1\nb: >-\n  x") + '\0' + "y\n";
+  try {
+    (void)load_yaml(text);
+    FAIL() << "expected a ParserException";
+  } catch (const YAML::ParserException& e) {
+    EXPECT_EQ(e.mark.line, 2);
+    EXPECT_EQ(e.mark.column, 3);
+    EXPECT_NE(std::string(e.what()).find("NUL byte"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace mmm
