@@ -191,8 +191,10 @@ ActionLinePath action_line_path(const atlas::Atlas& atlas, const atlas::Muscle& 
     }
     return places;
   };
+  const bool has_followers = std::ranges::any_of(placed, [](const Placed& p) { return p.follows; });
   const std::vector<Eigen::Vector3d> drawn = faded(true);
-  const std::vector<Eigen::Vector3d> of_action = faded(false);
+  // Without followers the line of action is the drawn path (no second pass).
+  const std::vector<Eigen::Vector3d> of_action = has_followers ? faded(false) : drawn;
   ActionLinePath path;
   std::vector<Eigen::Vector3d> anchors;
   std::vector<std::string> anchor_bones;
