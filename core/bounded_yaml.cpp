@@ -20,10 +20,21 @@ class ExpandedSizeCheck : public YAML::EventHandler {
  public:
   explicit ExpandedSizeCheck(const YamlLimits& limits) : limits_(limits) {}
 
-  void OnDocumentStart(const YAML::Mark& /*mark*/) override {
+  // yaml-cpp 0.7 reads a stray ',' at the top level (a file of just ",")
+  // as an empty document and starts the next one at the same place, without
+  // end (found by fuzzing): a document that starts where the previous one
+  // did is refused. The node limit holds for the whole text, so many small
+  // documents cannot pass it either.
+  void OnDocumentStart(const YAML::Mark& mark) override {
+    if (documents_ > 0 && mark.pos == last_document_start_) {
+      throw YAML::ParserException(mark,
+                                  "the text cannot be read past this place (a stray ',' or "
+                                  "another character that starts no YAML node?)");
+    }
+    ++documents_;
+    last_document_start_ = mark.pos;
     anchored_.clear();
     open_.clear();
-    nodes_ = 0;
   }
   void OnDocumentEnd() override {}
 
@@ -80,7 +91,7 @@ class ExpandedSizeCheck : public YAML::EventHandler {
   void add(const YAML::Mark& mark, std::size_t nodes, std::size_t height) {
     if (nodes > limits_.max_nodes - nodes_) {
       throw YAML::ParserException(
-          mark, "with its aliases expanded the document holds more than " +
+          mark, "with its aliases expanded the text holds more than " +
                     std::to_string(limits_.max_nodes) +
                     " nodes (an alias bomb?); hint: write repeated values out, or split the file");
     }
@@ -112,6 +123,8 @@ class ExpandedSizeCheck : public YAML::EventHandler {
   std::map<YAML::anchor_t, Expanded> anchored_;
   std::vector<Collection> open_;
   std::size_t nodes_ = 0;
+  std::size_t documents_ = 0;
+  int last_document_start_ = -1;
 };
 
 YAML::Mark start_of_text() { return {}; }

@@ -25,7 +25,8 @@ namespace mmm {
 struct YamlLimits {
   // Size of the text; a file is refused before it is read.
   std::size_t max_bytes = std::size_t{16} << 20;
-  // Nodes of a document (scalars, sequences, maps) with every alias expanded.
+  // Nodes of the text (scalars, sequences, maps of all its documents) with
+  // every alias expanded.
   std::size_t max_nodes = 2'000'000;
   // Nesting of sequences and maps, aliases expanded.
   std::size_t max_depth = 128;

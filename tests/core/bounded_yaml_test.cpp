@@ -107,5 +107,23 @@ TEST(BoundedYamlTest, ANulByteIsRefusedWithItsLineBeforeParsing) {
   }
 }
 
+// yaml-cpp 0.7 reads a stray ',' as an empty document and starts the next
+// one at the same place without end (found by fuzzing a recipe).
+TEST(BoundedYamlTest, AStrayCommaThatWouldMakeEmptyDocumentsWithoutEndIsRefusedAtItsLine) {
+  const std::string refusal = yaml_refusal("# a recipe\n, name: leg\n");
+  EXPECT_EQ(refusal.substr(0, 7), "line 2:") << refusal;
+  EXPECT_NE(refusal.find("stray ','"), std::string::npos) << refusal;
+  EXPECT_NE(yaml_refusal(","), "");
+}
+
+TEST(BoundedYamlTest, TheNodeLimitHoldsForAllDocumentsOfTheText) {
+  std::string documents;
+  for (int i = 0; i < 10; ++i) documents += "[a, b]\n---\n";
+  documents += "[a, b]\n";
+  EXPECT_EQ(yaml_refusal(documents, {.max_nodes = 33}), "");
+  EXPECT_NE(yaml_refusal(documents, {.max_nodes = 32}).find("more than 32 nodes"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace mmm
