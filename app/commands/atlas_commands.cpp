@@ -75,6 +75,18 @@ nlohmann::json build_json(const atlas::AtlasBuildReport& report) {
                      {"insertion_on_contact", l.insertion_on_contact}});
   }
   json["action_lines"] = lines;
+  nlohmann::json surfaces = nlohmann::json::array();
+  for (const atlas::WrapSurfaceFitReport& w : report.wrap_surfaces) {
+    surfaces.push_back({{"name", w.name},
+                        {"bone", w.bone},
+                        {"shape", std::string(atlas::wrap_shape_name(w.shape))},
+                        {"region_vertices", w.vertices},
+                        {"fit_rms_mm", w.rms_mm},
+                        {"shrink", w.shrink},
+                        {"shrunk_by", w.shrunk_by},
+                        {"radii_mm", {w.radii.x(), w.radii.y(), w.radii.z()}}});
+  }
+  json["wrap_surfaces"] = surfaces;
   json["notes"] = report.notes;
   return json;
 }
@@ -114,6 +126,17 @@ void print_build(const atlas::AtlasBuildReport& report) {
               << (l.insertion_on_contact ? ", insertion on contact" : "") << '\n';
   }
   std::cout << std::setprecision(2);
+  if (!report.wrap_surfaces.empty()) {
+    std::cout << "wrap surfaces fitted to the bones (fit RMS; shrunk to keep the lines' points "
+                 "outside):\n";
+  }
+  for (const atlas::WrapSurfaceFitReport& w : report.wrap_surfaces) {
+    std::cout << "  " << std::left << std::setw(30) << w.name << std::setw(9)
+              << atlas::wrap_shape_name(w.shape) << " on " << std::setw(8) << w.bone << std::right
+              << " radii " << w.radii.x() << " " << w.radii.y() << " " << w.radii.z() << " mm, rms "
+              << w.rms_mm << " mm over " << w.vertices << " vertices, x" << w.shrink
+              << (w.shrunk_by.empty() ? "" : " (" + w.shrunk_by + ")") << '\n';
+  }
   for (const std::string& note : report.notes) std::cout << "note: " << note << '\n';
   std::cout << "built in " << report.seconds << " s\n";
 }

@@ -14,6 +14,7 @@
 #include "core/atlas/muscle_cleanup.h"
 #include "core/atlas/opensim_mapping.h"
 #include "core/atlas/surface_line.h"
+#include "core/atlas/wrap_surfaces.h"
 #include "core/errors.h"
 #include "core/fit/sphere_fit.h"
 #include "core/mesh/aabb_tree.h"
@@ -740,6 +741,7 @@ AtlasBuildReport Builder::run(const std::filesystem::path& out_dir) {
   map_markers();
   place_landmarks();
   clean_and_attach();
+  report_.wrap_surfaces = add_wrap_surfaces(recipe_, bone_meshes_, atlas_);
   for (const RecipeRegion& recipe_region : recipe_.regions) {
     Region region{recipe_region.name, recipe_region.tags, {}, {}};
     for (const RecipeBone& bone : recipe_.bones) {

@@ -30,6 +30,7 @@
 
 #include "core/atlas/atlas.h"
 #include "core/atlas/atlas_recipe.h"
+#include "core/atlas/wrap_surface_fit.h"
 
 namespace mmm::atlas {
 
@@ -78,6 +79,7 @@ struct AtlasBuildReport {
   std::vector<MuscleBuildReport> muscles;
   std::vector<JointBuildReport> joints;
   std::vector<ActionLineBuildReport> action_lines;
+  std::vector<WrapSurfaceFitReport> wrap_surfaces;
   std::vector<std::string> notes;  // what was skipped or approximated, one sentence each
   double seconds = 0.0;
 };

@@ -146,6 +146,68 @@ void check_unique(const RecipeReader& reader, const YAML::Node& root, const std:
   }
 }
 
+// Sides a wrap surface may name: atlas directions.
+const std::set<std::string> kWrapSides{"anterior", "posterior", "superior",
+                                       "inferior", "right",     "left"};
+
+void read_wrap_surfaces(const RecipeReader& reader, const YAML::Node& root, AtlasRecipe& recipe) {
+  std::set<std::string> lines;
+  for (const RecipeMuscle& muscle : recipe.muscles) {
+    lines.insert(muscle.action_lines.begin(), muscle.action_lines.end());
+    if (!muscle.surface_line.empty()) lines.insert(muscle.name);
+  }
+  int index = 0;
+  for (const YAML::Node& item :
+       reader.items(root, "wrap_surfaces",
+                    {"name", "bone", "shape", "around_joint", "around_point", "radius_mm", "side",
+                     "axis_of_joint", "lines", "replaces", "clearance_mm", "offset_mm"})) {
+    const std::string field = "wrap_surfaces[" + std::to_string(index++) + "]";
+    RecipeWrapSurface surface;
+    surface.name = reader.text(item, "name", field, true);
+    surface.bone = reader.text(item, "bone", field, true);
+    if (std::ranges::none_of(recipe.bones,
+                             [&](const RecipeBone& bone) { return bone.name == surface.bone; })) {
+      reader.fail(item["bone"], field + ".bone", "unknown bone '" + surface.bone + "'");
+    }
+    const std::string shape = reader.text(item, "shape", field, true);
+    const auto parsed = wrap_shape_from_name(shape);
+    if (!parsed) {
+      reader.fail(item["shape"], field + ".shape",
+                  "unknown shape '" + shape + "' (expected sphere, cylinder or ellipsoid)");
+    }
+    surface.shape = *parsed;
+    surface.around_joint = reader.text(item, "around_joint", field);
+    surface.around_point = reader.text(item, "around_point", field);
+    if (surface.around_joint.empty() == surface.around_point.empty()) {
+      reader.fail(item, field, "names its region's centre by around_joint or around_point (one)");
+    }
+    surface.radius_mm = reader.number(item, "radius_mm", field, 30.0, 5.0, 200.0);
+    surface.side = reader.text(item, "side", field);
+    if (!surface.side.empty() && !kWrapSides.contains(surface.side)) {
+      reader.fail(item["side"], field + ".side",
+                  "unknown side '" + surface.side +
+                      "' (expected anterior, posterior, superior, inferior, right or left)");
+    }
+    surface.axis_of_joint = reader.text(item, "axis_of_joint", field);
+    if (!surface.axis_of_joint.empty() && surface.shape != WrapShape::kCylinder) {
+      reader.fail(item["axis_of_joint"], field + ".axis_of_joint", "is for cylinders only");
+    }
+    surface.lines = reader.texts(item, "lines", field);
+    if (surface.lines.empty()) reader.fail(item, field + ".lines", "names at least one line");
+    for (const std::string& line : surface.lines) {
+      if (!lines.contains(line)) {
+        reader.fail(item["lines"], field + ".lines",
+                    "'" + line + "' is not an action line of any muscle of the recipe");
+      }
+    }
+    surface.replaces = reader.texts(item, "replaces", field);
+    surface.clearance_mm = reader.number(item, "clearance_mm", field, 2.0, 0.0, 20.0);
+    surface.offset_mm = reader.number(item, "offset_mm", field, 0.0, 0.0, 50.0);
+    recipe.wrap_surfaces.push_back(std::move(surface));
+  }
+  check_unique(reader, root, "wrap_surfaces", recipe.wrap_surfaces);
+}
+
 }  // namespace
 
 AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
@@ -164,7 +226,7 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
       root, "(top)",
       {"mmm_atlas_recipe", "name", "description", "frame", "opensim", "midline", "lod_faces",
        "penetration_tolerance_mm", "attachment_distance_mm", "attachment_radius_mm", "regions",
-       "bones", "registration", "muscles", "landmarks"});
+       "bones", "registration", "muscles", "landmarks", "wrap_surfaces"});
   AtlasRecipe recipe;
   recipe.source = file;
   const double format = reader.number(root, "mmm_atlas_recipe", "(top)", -1, -1e9, 1e9);
@@ -397,6 +459,7 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
     recipe.landmarks.push_back(std::move(landmark));
   }
   check_unique(reader, root, "landmarks", recipe.landmarks);
+  read_wrap_surfaces(reader, root, recipe);
   return recipe;
 }
 

@@ -17,6 +17,10 @@
 //   muscles:
 //     - {name: gluteus_medius_r, file: ..., action_lines: [glut_med1_r, ...], ...}
 //   landmarks: ...
+//   wrap_surfaces:                       # fitted to the bones, see wrap_surface_fit.h
+//     - {name: gastroc_at_condyles_r, bone: femur_r, shape: cylinder, around_joint: knee_r,
+//        radius_mm: 35, side: posterior, axis_of_joint: knee_r, lines: [med_gas_r, lat_gas_r],
+//        replaces: [med_gas_r-P2, lat_gas_r-P2]}
 //
 // Paths of data files are relative to the data folder (by default
 // `../shared/data` beside the checkout; `--data` overrides).
@@ -106,6 +110,32 @@ struct RecipeLandmark {
   std::string description;
 };
 
+// A wrap surface fitted to a bone region (wrap_surface_fit.h): the lines
+// named wrap over it, and the path points it replaces (gait2392's
+// conditional points that stand in for wrapping) are left out of them.
+struct RecipeWrapSurface {
+  std::string name;
+  std::string bone;
+  WrapShape shape = WrapShape::kCylinder;
+  // The region's centre: a joint's centre (OpenSim joint name) or a path
+  // point of an action line ("iliacus_r-P3"), at rest.
+  std::string around_joint;
+  std::string around_point;
+  double radius_mm = 30.0;
+  // Lines wrap on this side only: anterior, posterior, superior, inferior,
+  // right, left (atlas frame); empty for all round. Around a joint, only the
+  // bone vertices on that side of the centre are fitted (around a path
+  // point, which lies on the muscle, all within the radius).
+  std::string side;
+  std::string axis_of_joint;          // cylinder: start from this joint's first rotation axis
+  std::vector<std::string> lines;     // action line names
+  std::vector<std::string> replaces;  // path point names removed from those lines
+  double clearance_mm = 2.0;          // the lines' own points are kept this far outside
+  // Added to the fitted radii: the lines of action run through the middle of
+  // their muscles, this far out from the bone (and what lies on it).
+  double offset_mm = 0.0;
+};
+
 struct RecipeRegion {
   std::string name;
   std::vector<std::string> tags;
@@ -130,6 +160,7 @@ struct AtlasRecipe {
   std::vector<RecipeRegistration> registrations;
   std::vector<RecipeMuscle> muscles;
   std::vector<RecipeLandmark> landmarks;
+  std::vector<RecipeWrapSurface> wrap_surfaces;
 };
 
 // Reads and checks a recipe. Throws IoError naming the file, the line and

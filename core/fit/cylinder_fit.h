@@ -24,8 +24,8 @@ struct CylinderFitResult {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // on the axis, mid-extent of the points (mm)
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   // unit; its sign follows the hint
   double radius = 0;                                 // mm
-  double length = 0;  // extent of the points along the axis (mm)
-  double rms = 0;     // RMS distance of the points to the cylinder (mm)
+  double length = 0;                                 // extent of the points along the axis (mm)
+  double rms = 0;  // RMS distance of the points to the cylinder (mm)
   bool converged = false;
 };
 

@@ -71,7 +71,8 @@ EllipsoidFitResult ellipsoid_fit(const Eigen::MatrixX3d& points,
   if (!points.allFinite()) throw InvalidInputError("ellipsoid_fit: a point is not finite");
   const Eigen::Vector3d mean = points.colwise().mean().transpose();
   const Eigen::MatrixX3d centred = points.rowwise() - mean.transpose();
-  const Eigen::Matrix3d covariance = centred.transpose() * centred / static_cast<double>(points.rows());
+  const Eigen::Matrix3d covariance =
+      centred.transpose() * centred / static_cast<double>(points.rows());
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
   const Eigen::Vector3d variance = solver.eigenvalues().cwiseMax(0.0);  // ascending
   if (!(variance[0] >= kFlatEllipsoidVarianceRatio * variance[2])) {
@@ -82,8 +83,7 @@ EllipsoidFitResult ellipsoid_fit(const Eigen::MatrixX3d& points,
   EllipsoidStart from;
   if (start) {
     from = *start;
-    if (!from.centre.allFinite() || !from.axes.allFinite() ||
-        !(from.semi_axes.array() > 0).all()) {
+    if (!from.centre.allFinite() || !from.axes.allFinite() || !(from.semi_axes.array() > 0).all()) {
       throw InvalidInputError("ellipsoid_fit: the start is not finite or has a semi-axis <= 0");
     }
   } else {
@@ -117,8 +117,8 @@ EllipsoidFitResult ellipsoid_fit(const Eigen::MatrixX3d& points,
   EllipsoidFitResult result;
   result.centre = from.centre + from.axes * Eigen::Vector3d(centre[0], centre[1], centre[2]);
   result.axes = from.axes * rotation_of(turn);
-  result.semi_axes = Eigen::Vector3d(std::exp(log_semi[0]), std::exp(log_semi[1]),
-                                     std::exp(log_semi[2]));
+  result.semi_axes =
+      Eigen::Vector3d(std::exp(log_semi[0]), std::exp(log_semi[1]), std::exp(log_semi[2]));
   double squared = 0;
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     const Eigen::Vector3d q = result.axes.transpose() * (points.row(i).transpose() - result.centre);

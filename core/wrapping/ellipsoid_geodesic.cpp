@@ -234,6 +234,7 @@ WrapResult wrap_ellipsoid(const Vector3d& p_world, const Vector3d& s_world,
   unit.quadrant = obstacle.quadrant;
   WrapOptions fine;
   fine.arc_step_mm = kUnitArcStep;
+  fine.shrink_to_inside_points = false;  // the caller has shrunk the ellipsoid if it had to
   const WrapResult sphere =
       wrap_segment(p.cwiseQuotient(radii), s.cwiseQuotient(radii), unit, fine);
   if (sphere.inside) return straight(p_world, s_world, true);

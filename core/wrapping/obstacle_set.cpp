@@ -1,5 +1,6 @@
 #include "core/wrapping/obstacle_set.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -173,6 +174,28 @@ WrapResult wrap_cylinder(const Eigen::Vector3d& p_world, const Eigen::Vector3d& 
   return result;
 }
 
+// How far out `point` lies, as a multiple of the obstacle's size (1 on its
+// surface): distance from the centre over the radius (a cylinder: from the
+// axis), for an ellipsoid |q ./ radii|.
+double size_ratio(const Eigen::Vector3d& point, const Obstacle& obstacle) {
+  const Eigen::Vector3d q = obstacle.pose.inverse() * point;
+  switch (obstacle.shape) {
+    case ObstacleShape::kSphere:
+      return q.norm() / obstacle.radius;
+    case ObstacleShape::kCylinder:
+      return q.head<2>().norm() / obstacle.radius;
+    case ObstacleShape::kEllipsoid:
+      return q.cwiseQuotient(obstacle.radii).norm();
+  }
+  return 1.0;
+}
+
+// Inside points are kept this fraction of their distance outside the shrunk
+// obstacle; below kSmallestShrink (a point at the centre) the segment stays
+// straight.
+constexpr double kShrinkMargin = 0.999;
+constexpr double kSmallestShrink = 0.02;
+
 }  // namespace
 
 WrapResult wrap_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& s,
@@ -190,6 +213,21 @@ WrapResult wrap_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& s,
     throw InvalidInputError("wrap obstacle: the path's end points must be finite");
   }
   const Quadrant quadrant = parse_quadrant(obstacle.quadrant, obstacle.shape);
+  // Points on the surface or just outside it shrink the obstacle too (by
+  // at most the margin), so the shrinking starts continuously.
+  const double nearest = std::min(size_ratio(p, obstacle), size_ratio(s, obstacle));
+  const double shrink = std::min(1.0, kShrinkMargin * nearest);
+  if (shrink < 1.0 && options.shrink_to_inside_points) {
+    if (shrink < kSmallestShrink) return straight(p, s, true);
+    Obstacle smaller = obstacle;
+    smaller.radius *= shrink;
+    smaller.radii *= shrink;
+    WrapOptions plain = options;
+    plain.shrink_to_inside_points = false;
+    WrapResult result = wrap_segment(p, s, smaller, plain);
+    result.inside = nearest <= 1.0;
+    return result;
+  }
   switch (obstacle.shape) {
     case ObstacleShape::kSphere:
       return wrap_sphere(p, s, obstacle, quadrant, options);

@@ -22,7 +22,13 @@
 // with a quadrant ("+x", "-y", ...: the side of the obstacle, in its frame,
 // the path may wrap on), only on that side: a straight line outside the
 // allowed side is left straight, a path that must wrap goes around it.
-// Points inside the obstacle have no wrapping path (reported, straight).
+// An end point inside the obstacle (a moving insertion that comes close to
+// the bone the obstacle stands for) has no wrapping path: by default the
+// obstacle is shrunk about its centre for that segment until the point lies
+// just outside it (0.999 of its distance), so the path, its length and the
+// moment arm stay continuous as the point goes in; OpenSim's behaviour, a
+// straight segment (a jump in length), is the other choice. Either way the
+// result is flagged `inside`.
 
 #include <Eigen/Geometry>
 #include <string>
@@ -44,7 +50,7 @@ struct Obstacle {
 
 struct WrapResult {
   bool wrapped = false;  // the path touches the obstacle
-  bool inside = false;   // P or S lies inside the obstacle: no wrapping path exists
+  bool inside = false;   // P or S lies inside the obstacle (see WrapOptions)
   Eigen::Vector3d tangent_in = Eigen::Vector3d::Zero();   // T1 (world, mm) when wrapped
   Eigen::Vector3d tangent_out = Eigen::Vector3d::Zero();  // T2
   // rad swept on the obstacle (in the xy-plane for a cylinder; for an
@@ -58,6 +64,9 @@ struct WrapResult {
 
 struct WrapOptions {
   double arc_step_mm = 2.0;  // resolution of the wrapped part of `points`
+  // An end point inside: shrink the obstacle to it (continuous), or leave
+  // the segment straight (OpenSim).
+  bool shrink_to_inside_points = true;
 };
 
 // Throws InvalidInputError for a non-positive radius (an ellipsoid: radii),

@@ -121,6 +121,14 @@ TEST(AtlasRecipeTest, DefaultRecipeReads) {
   ASSERT_NE(popliteus, recipe.muscles.end());
   EXPECT_EQ(popliteus->surface_line, (std::vector<std::string>{"femur_r", "tibia_r"}));
   EXPECT_TRUE(popliteus->action_lines.empty());
+  // Wrap surfaces fitted to her bones replace gait2392's conditional points
+  // of the gastrocnemii, semimembranosus, rectus femoris and iliopsoas.
+  ASSERT_EQ(recipe.wrap_surfaces.size(), 3U);
+  const RecipeWrapSurface& condyles = recipe.wrap_surfaces.front();
+  EXPECT_EQ(condyles.shape, WrapShape::kCylinder);
+  EXPECT_EQ(condyles.axis_of_joint, "knee_r");
+  EXPECT_EQ(condyles.side, "posterior");
+  EXPECT_EQ(condyles.replaces.size(), condyles.lines.size());
 }
 
 TEST(AtlasRecipeTest, SmallRecipeReads) {
@@ -193,6 +201,32 @@ TEST(AtlasRecipeTest, ASurfaceLineNeedsTwoKnownBonesAndNoOpenSimPath) {
   EXPECT_THAT(rejection(edited("action_lines: [glut_max1_r]",
                                "action_lines: [glut_max1_r], surface_line: [sacrum, femur_r]")),
               HasSubstr("either action_lines (OpenSim paths) or a surface_line"));
+}
+
+TEST(AtlasRecipeTest, AWrapSurfaceNamesItsBoneShapeCentreAndKnownLines) {
+  const std::string surface =
+      "wrap_surfaces:\n  - {name: s, bone: femur_r, shape: cylinder, around_joint: knee_r,\n"
+      "     side: posterior, axis_of_joint: knee_r, lines: [glut_max1_r], replaces: [P2]}\n";
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string text = std::string(kRecipe) + surface;
+    // Edits apply to the wrap surface (after the recipe's own text).
+    if (!from.empty()) text.replace(text.find(from, std::string(kRecipe).size()), from.size(), to);
+    return rejection(text);
+  };
+  EXPECT_EQ(with("", ""), "");
+  EXPECT_THAT(with("bone: femur_r, shape", "bone: femr, shape"),
+              HasSubstr("wrap_surfaces[0].bone: unknown bone 'femr'"));
+  EXPECT_THAT(with("cylinder", "torus"), HasSubstr("unknown shape 'torus'"));
+  EXPECT_THAT(with("around_joint: knee_r", "around_point: x-P1, around_joint: knee_r"),
+              HasSubstr("by around_joint or around_point (one)"));
+  EXPECT_THAT(with("around_joint: knee_r,", ""), HasSubstr("by around_joint or around_point"));
+  EXPECT_THAT(with("posterior", "behind"), HasSubstr("unknown side 'behind'"));
+  EXPECT_THAT(with("cylinder", "sphere"), HasSubstr("axis_of_joint: is for cylinders only"));
+  EXPECT_THAT(with("lines: [glut_max1_r]", "lines: [glut_max9_r]"),
+              HasSubstr("'glut_max9_r' is not an action line of any muscle"));
+  EXPECT_THAT(with("lines: [glut_max1_r]", "lines: []"), HasSubstr("names at least one line"));
+  EXPECT_THAT(with("replaces", "offset_mm: 80, replaces"),
+              HasSubstr("wrap_surfaces[0].offset_mm: is 80, outside [0, 50]"));
 }
 
 TEST(AtlasRecipeTest, DuplicateNamesAreRejected) {

@@ -34,8 +34,8 @@ Eigen::MatrixX3d sample_cylinder(int count, double half_angle, double length, do
   for (int i = 0; i < count; ++i) {
     const double angle = (2.0 * open_unit(rng) - 1.0) * half_angle;
     const double along = (open_unit(rng) - 0.5) * length;
-    const Eigen::Vector3d p =
-        kCylinderAxisPoint + along * kCylinderAxis + kCylinderRadius * (std::cos(angle) * u + std::sin(angle) * v);
+    const Eigen::Vector3d p = kCylinderAxisPoint + along * kCylinderAxis +
+                              kCylinderRadius * (std::cos(angle) * u + std::sin(angle) * v);
     points.row(i) = (p + gaussian_vector(rng, sigma)).transpose();
   }
   return points;
@@ -48,7 +48,8 @@ double distance_to_axis(const CylinderFitResult& fit, const Eigen::Vector3d& p) 
 
 TEST(CylinderFitTest, ExactPointsOnAHalfCylinderGiveItBackFromARoughAxisHint) {
   const Eigen::MatrixX3d points = sample_cylinder(400, std::numbers::pi / 2, 40.0, 0.0, 1);
-  const Eigen::Vector3d rough = (kCylinderAxis + Eigen::Vector3d(0, 0.2, 0.15)).normalized();  // ~14 deg off
+  const Eigen::Vector3d rough =
+      (kCylinderAxis + Eigen::Vector3d(0, 0.2, 0.15)).normalized();  // ~14 deg off
   const CylinderFitResult fit = cylinder_fit(points, rough);
   EXPECT_TRUE(fit.converged);
   EXPECT_NEAR(fit.radius, kCylinderRadius, 1e-6);

@@ -31,7 +31,8 @@ Eigen::MatrixX3d sample_ellipsoid(int count, double lowest_z, double sigma, unsi
   for (int i = 0; i < count;) {
     const Eigen::Vector3d n = unit_direction(rng);
     if (n.z() < lowest_z) continue;
-    const Eigen::Vector3d p = kEllipsoidCentre + kEllipsoidAxes * n.cwiseProduct(kEllipsoidSemiAxes);
+    const Eigen::Vector3d p =
+        kEllipsoidCentre + kEllipsoidAxes * n.cwiseProduct(kEllipsoidSemiAxes);
     points.row(i++) = (p + gaussian_vector(rng, sigma)).transpose();
   }
   return points;

@@ -145,3 +145,45 @@ TEST(ObstacleSetTest, BadObstaclesAreErrors) {
 
 }  // namespace
 }  // namespace mmm::wrapping
+
+namespace mmm::wrapping {
+namespace {
+
+// An insertion moving into the obstacle (every shape): the obstacle shrinks
+// to keep it just outside, so the length changes smoothly; OpenSim's
+// straight segment jumps by the wrap's detour.
+TEST(ObstacleSetTest, AnEndPointMovingInsideShrinksTheObstacleAndKeepsTheLengthContinuous) {
+  Obstacle cylinder;
+  cylinder.shape = ObstacleShape::kCylinder;
+  cylinder.radius = 20.0;
+  Obstacle ellipsoid;
+  ellipsoid.shape = ObstacleShape::kEllipsoid;
+  ellipsoid.radii = Eigen::Vector3d(20.0, 25.0, 30.0);
+  Obstacle sphere;
+  sphere.radius = 20.0;
+  for (const Obstacle& obstacle : {sphere, cylinder, ellipsoid}) {
+    const Eigen::Vector3d p(-60.0, 5.0, 3.0);
+    double previous = -1.0;
+    double largest_step = 0.0;
+    bool went_inside = false;
+    // S from 40 mm out to 10 mm from the centre, 0.1 mm at a time.
+    for (double x = 40.0; x >= 10.0; x -= 0.1) {
+      const WrapResult result = wrap_segment(p, Eigen::Vector3d(x, -4.0, 0.0), obstacle);
+      went_inside = went_inside || result.inside;
+      if (previous >= 0) largest_step = std::max(largest_step, std::abs(result.length - previous));
+      previous = result.length;
+    }
+    EXPECT_TRUE(went_inside);
+    EXPECT_LT(largest_step, 0.25) << "shape " << static_cast<int>(obstacle.shape);
+    WrapOptions opensim;
+    opensim.shrink_to_inside_points = false;
+    const WrapResult outside = wrap_segment(p, Eigen::Vector3d(20.5, -4.0, 0.0), obstacle, opensim);
+    const WrapResult in = wrap_segment(p, Eigen::Vector3d(19.0, -4.0, 0.0), obstacle, opensim);
+    EXPECT_TRUE(in.inside);
+    EXPECT_FALSE(in.wrapped);
+    EXPECT_GT(outside.length - in.length, 1.0);  // the jump the default avoids
+  }
+}
+
+}  // namespace
+}  // namespace mmm::wrapping
