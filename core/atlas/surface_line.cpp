@@ -11,6 +11,9 @@
 namespace mmm::atlas {
 namespace {
 
+// Via points on different bones closer than this pass through each other as
+// the joint between them moves (mm).
+constexpr double kCrossingGap_mm = 15.0;
 constexpr Eigen::Index kFewestContactVertices = 8;
 
 Eigen::Vector3d contact_middle(const mesh::IndexedMesh& muscle, const mesh::AabbTree& bone,
@@ -105,6 +108,20 @@ SurfaceLine surface_action_line(const std::string& name, const mesh::IndexedMesh
           inside_point(sum / count, muscle_tree, winding));
   }
   point("P" + std::to_string(result.line.points.size() + 1), insertion.name, end);
+  // The two via points either side of the change of bone sit on different
+  // bones: closer than kCrossingGap_mm they pass through each other as the
+  // joint moves (a kink in the length, a jump in the moment arm), so they
+  // only bend the drawn path (kFollowsLine) and the line of action runs
+  // between the points around them.
+  std::vector<PathPoint>& line_points = result.line.points;
+  for (std::size_t i = 1; i + 2 < line_points.size(); ++i) {
+    PathPoint& before = line_points[i];
+    PathPoint& after = line_points[i + 1];
+    if (before.bone != after.bone && (after.position - before.position).norm() < kCrossingGap_mm) {
+      before.kind = PathPointKind::kFollowsLine;
+      after.kind = PathPointKind::kFollowsLine;
+    }
+  }
   // The tendon is what the path runs outside the muscle before it first
   // enters it and after it last leaves it (sampled every 0.5 mm); the belly
   // the rest.

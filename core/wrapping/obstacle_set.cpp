@@ -195,6 +195,17 @@ double size_ratio(const Eigen::Vector3d& point, const Obstacle& obstacle) {
 // straight.
 constexpr double kShrinkMargin = 0.999;
 constexpr double kSmallestShrink = 0.02;
+// The shrinking starts smoothly over this fraction of the size around the
+// surface: the size follows the point with a continuous derivative, so the
+// moment arm (the length's derivative) does not jump where it starts.
+constexpr double kShrinkBlend = 0.3;
+
+// min(a, b) with the corner rounded over `k` (quadratic: continuous first
+// derivative; equal to min(a, b) once |a - b| >= k, never above it).
+double smooth_min(double a, double b, double k) {
+  const double h = std::max(k - std::abs(a - b), 0.0) / k;
+  return std::min(a, b) - h * h * k / 4.0;
+}
 
 }  // namespace
 
@@ -216,7 +227,7 @@ WrapResult wrap_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& s,
   // Points on the surface or just outside it shrink the obstacle too (by
   // at most the margin), so the shrinking starts continuously.
   const double nearest = std::min(size_ratio(p, obstacle), size_ratio(s, obstacle));
-  const double shrink = std::min(1.0, kShrinkMargin * nearest);
+  const double shrink = smooth_min(1.0, kShrinkMargin * nearest, kShrinkBlend);
   if (shrink < 1.0 && options.shrink_to_inside_points) {
     if (shrink < kSmallestShrink) return straight(p, s, true);
     Obstacle smaller = obstacle;

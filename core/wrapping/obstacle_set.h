@@ -25,8 +25,9 @@
 // An end point inside the obstacle (a moving insertion that comes close to
 // the bone the obstacle stands for) has no wrapping path: by default the
 // obstacle is shrunk about its centre for that segment until the point lies
-// just outside it (0.999 of its distance), so the path, its length and the
-// moment arm stay continuous as the point goes in; OpenSim's behaviour, a
+// just outside it (0.999 of its distance; the shrinking starts smoothly
+// from 30 % of the size around the surface), so the path, its length and
+// the moment arm stay continuous as the point goes in; OpenSim's behaviour, a
 // straight segment (a jump in length), is the other choice. Either way the
 // result is flagged `inside`.
 

@@ -43,6 +43,17 @@ TEST(SurfaceLineTest, RunsFromContactToContactThroughTheBellyAndMeasuresTheTendo
     EXPECT_TRUE(winding.is_inside(line.line.points[i].position)) << line.line.points[i].name;
     EXPECT_EQ(line.line.points[i].bone, line.line.points[i].position.z() < 85 ? "lower" : "upper");
   }
+  // The via points either side of the change of bone, ~9 mm apart, would
+  // pass through each other as the joint moves: they only follow the line.
+  int followers = 0;
+  for (std::size_t i = 1; i + 1 < line.line.points.size(); ++i) {
+    const PathPoint& point = line.line.points[i];
+    const bool straddles =
+        point.bone != line.line.points[i - 1].bone || point.bone != line.line.points[i + 1].bone;
+    EXPECT_EQ(point.kind == PathPointKind::kFollowsLine, straddles) << point.name;
+    followers += point.kind == PathPointKind::kFollowsLine ? 1 : 0;
+  }
+  EXPECT_EQ(followers, 2);
   // Belly 100 mm (the spindle), tendon the 30 mm gap (0.5 mm sampling).
   EXPECT_NEAR(line.belly_mm, 100.0, 1.5);
   EXPECT_NEAR(line.tendon_mm, 30.0, 1.5);
