@@ -114,14 +114,19 @@ std::vector<WrapSurfaceFitReport> add_wrap_surfaces(
             std::ranges::find_if(points, [&](const PathPoint& p) { return p.name == gone; });
         if (at == points.end()) continue;
         if (at == points.begin() || std::next(at) == points.end()) {
-          fail(surface, "it cannot replace " + gone + ", an end of line " + name);
+          std::string problem = "it cannot replace ";
+          problem += gone;
+          problem += ", an end of line ";
+          problem += name;
+          fail(surface, problem);
         }
         points.erase(at);
         replaced.insert(gone);
       }
       for (const PathPoint& point : points) {
-        if (point.kind != PathPointKind::kFollowsLine)
+        if (point.kind != PathPointKind::kFollowsLine) {
           outside.push_back({point.name, point.position});
+        }
       }
     }
     for (const std::string& gone : surface.replaces) {

@@ -6,8 +6,10 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "core/errors.h"
 
@@ -29,14 +31,14 @@ Eigen::Matrix3d frame_along(const Eigen::Vector3d& axis) {
 // Distance of one point (in the start frame, relative to the start centre)
 // to the cylinder of parameters (a_x, a_y, u, v, r).
 struct CylinderResidual {
-  explicit CylinderResidual(const Eigen::Vector3d& s) : s_(s) {}
+  explicit CylinderResidual(Eigen::Vector3d s) : s_(std::move(s)) {}
 
   template <typename T>
   bool operator()(const T* const x, T* residual) const {
-    const T minus_turn[3] = {-x[0], -x[1], T(0)};
-    const T s[3] = {T(s_.x()), T(s_.y()), T(s_.z())};
-    T q[3];
-    ceres::AngleAxisRotatePoint(minus_turn, s, q);
+    const std::array<T, 3> minus_turn{-x[0], -x[1], T(0)};
+    const std::array<T, 3> s{T(s_.x()), T(s_.y()), T(s_.z())};
+    std::array<T, 3> q{};
+    ceres::AngleAxisRotatePoint(minus_turn.data(), s.data(), q.data());
     const T dx = q[0] - x[2];
     const T dy = q[1] - x[3];
     const T squared = dx * dx + dy * dy;
@@ -81,7 +83,7 @@ CylinderFitResult cylinder_fit(const Eigen::MatrixX3d& points,
   a.col(2).setOnes();
   const Eigen::VectorXd b = local.leftCols<2>().rowwise().squaredNorm();
   const Eigen::Vector3d circle = a.colPivHouseholderQr().solve(b);
-  double x[5] = {0, 0, circle.x(), circle.y(), 0};
+  std::array<double, 5> x{0, 0, circle.x(), circle.y(), 0};
   if (!std::isfinite(x[2]) || !std::isfinite(x[3])) x[2] = x[3] = 0;
   double mean_distance = 0;
   for (Eigen::Index i = 0; i < local.rows(); ++i) {
@@ -93,7 +95,7 @@ CylinderFitResult cylinder_fit(const Eigen::MatrixX3d& points,
   for (Eigen::Index i = 0; i < local.rows(); ++i) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CylinderResidual, 1, 5>(
                                  new CylinderResidual(local.row(i).transpose())),
-                             nullptr, x);
+                             nullptr, x.data());
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;

@@ -4,8 +4,10 @@
 #include <ceres/rotation.h>
 
 #include <Eigen/Eigenvalues>
+#include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "core/errors.h"
 
@@ -19,15 +21,15 @@ constexpr double kFlatEllipsoidVarianceRatio = 1e-12;
 // Ray distance of one point (start frame, relative to the start centre) to
 // the ellipsoid of parameters: centre (3), small turn (3), log semi-axes (3).
 struct EllipsoidResidual {
-  explicit EllipsoidResidual(const Eigen::Vector3d& s) : s_(s) {}
+  explicit EllipsoidResidual(Eigen::Vector3d s) : s_(std::move(s)) {}
 
   template <typename T>
   bool operator()(const T* const centre, const T* const turn, const T* const log_semi,
                   T* residual) const {
-    const T d[3] = {T(s_.x()) - centre[0], T(s_.y()) - centre[1], T(s_.z()) - centre[2]};
-    const T minus_turn[3] = {-turn[0], -turn[1], -turn[2]};
-    T q[3];
-    ceres::AngleAxisRotatePoint(minus_turn, d, q);
+    const std::array<T, 3> d{T(s_.x()) - centre[0], T(s_.y()) - centre[1], T(s_.z()) - centre[2]};
+    const std::array<T, 3> minus_turn{-turn[0], -turn[1], -turn[2]};
+    std::array<T, 3> q{};
+    ceres::AngleAxisRotatePoint(minus_turn.data(), d.data(), q.data());
     const T length_squared = q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
     T scaled_squared(0);
     for (int k = 0; k < 3; ++k) {
@@ -53,7 +55,7 @@ struct EllipsoidResidual {
   Eigen::Vector3d s_;
 };
 
-Eigen::Matrix3d rotation_of(const double* turn) {
+Eigen::Matrix3d rotation_of(const std::array<double, 3>& turn) {
   const Eigen::Vector3d w(turn[0], turn[1], turn[2]);
   const double angle = w.norm();
   return angle > 0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
@@ -94,15 +96,15 @@ EllipsoidFitResult ellipsoid_fit(const Eigen::MatrixX3d& points,
   }
   const Eigen::MatrixX3d local = (points.rowwise() - from.centre.transpose()) * from.axes;
 
-  double centre[3] = {0, 0, 0};
-  double turn[3] = {0, 0, 0};
-  double log_semi[3] = {std::log(from.semi_axes.x()), std::log(from.semi_axes.y()),
-                        std::log(from.semi_axes.z())};
+  std::array<double, 3> centre{0, 0, 0};
+  std::array<double, 3> turn{0, 0, 0};
+  std::array<double, 3> log_semi{std::log(from.semi_axes.x()), std::log(from.semi_axes.y()),
+                                 std::log(from.semi_axes.z())};
   ceres::Problem problem;
   for (Eigen::Index i = 0; i < local.rows(); ++i) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<EllipsoidResidual, 1, 3, 3, 3>(
                                  new EllipsoidResidual(local.row(i).transpose())),
-                             nullptr, centre, turn, log_semi);
+                             nullptr, centre.data(), turn.data(), log_semi.data());
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
