@@ -246,7 +246,7 @@ workflow::NodeSpec WrapMuscles::spec() {
   using workflow::port::File;
   using workflow::port::Report;
   const wrapping::MuscleWrappingOptions d;
-  return workflow::NodeSpec{"wrap_muscles", 5,
+  return workflow::NodeSpec{"wrap_muscles", 6,
                             "Muscle wrapping over a fused motion (energy pathway): per frame, "
                             "action lines re-routed on the "
                             "moving skeleton; each muscle surface deformed around them with its "

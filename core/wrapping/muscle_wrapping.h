@@ -96,7 +96,8 @@ struct MuscleWrappingOptions {
   // else the hull is built.
   std::vector<MuscleHull> hulls;
   std::vector<std::string> moment_arm_coordinates = {"hip_flexion_r", "hip_adduction_r",
-                                                     "hip_rotation_r", "knee_angle_r"};
+                                                     "hip_rotation_r", "knee_angle_r",
+                                                     "ankle_angle_r"};
   int threads = 0;  // 0: the hardware's
   DeformerOptions deformer;
   BindingOptions binding;
