@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "core/errors.h"
+#include "core/fit/dense_least_squares.h"
 
 namespace mmm::fit {
 namespace {
@@ -97,13 +98,7 @@ CylinderFitResult cylinder_fit(const Eigen::MatrixX3d& points,
                                  new CylinderResidual(local.row(i).transpose())),
                              nullptr, x.data());
   }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
-  options.max_num_iterations = 200;
-  options.function_tolerance = 1e-14;
-  options.parameter_tolerance = 1e-12;
-  options.gradient_tolerance = 1e-16;
-  options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options options = detail::dense_least_squares_options(200);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
 

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/errors.h"
+#include "core/fit/dense_least_squares.h"
 
 namespace mmm::fit {
 namespace {
@@ -106,13 +107,7 @@ EllipsoidFitResult ellipsoid_fit(const Eigen::MatrixX3d& points,
                                  new EllipsoidResidual(local.row(i).transpose())),
                              nullptr, centre.data(), turn.data(), log_semi.data());
   }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
-  options.max_num_iterations = 300;
-  options.function_tolerance = 1e-14;
-  options.parameter_tolerance = 1e-12;
-  options.gradient_tolerance = 1e-16;
-  options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options options = detail::dense_least_squares_options(300);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
 
