@@ -95,9 +95,8 @@ struct MuscleWrappingOptions {
   // wrapping surface and whose face count matches hull_faces is reused,
   // else the hull is built.
   std::vector<MuscleHull> hulls;
-  std::vector<std::string> moment_arm_coordinates = {"hip_flexion_r", "hip_adduction_r",
-                                                     "hip_rotation_r", "knee_angle_r",
-                                                     "ankle_angle_r"};
+  std::vector<std::string> moment_arm_coordinates = {
+      "hip_flexion_r", "hip_adduction_r", "hip_rotation_r", "knee_angle_r", "ankle_angle_r"};
   int threads = 0;  // 0: the hardware's
   DeformerOptions deformer;
   BindingOptions binding;
