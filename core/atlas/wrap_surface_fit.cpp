@@ -23,9 +23,7 @@ Eigen::Vector3d across(const Eigen::Vector3d& axis, const std::optional<Eigen::V
     const Eigen::Vector3d part = *wanted - wanted->dot(axis) * axis;
     if (part.norm() > 1e-6 * wanted->norm()) return part.normalized();
   }
-  const Eigen::Vector3d helper =
-      std::abs(axis.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  return (helper - helper.dot(axis) * axis).normalized();
+  return axis.unitOrthogonal();
 }
 
 Eigen::MatrixX3d region_vertices(const Eigen::MatrixX3d& vertices,
@@ -44,38 +42,41 @@ Eigen::MatrixX3d region_vertices(const Eigen::MatrixX3d& vertices,
   return out;
 }
 
-// The largest factor (<= 1) the obstacle's size may be multiplied by, about
-// its centre, for `point` to lie `clearance` outside.
-double allowed_scale(const WrapObstacle& obstacle, const Eigen::Vector3d& point, double clearance) {
+// Where `point` lies against the obstacle along the ray from its centre (a
+// cylinder: from its axis, across it): the ray's length and its length over
+// the surface's along the same ray (1 on the surface).
+struct Radial {
+  double length = 0.0;
+  double ratio = 0.0;
+};
+
+Radial radial(const WrapObstacle& obstacle, const Eigen::Vector3d& point) {
   const Eigen::Vector3d q = obstacle.pose.inverse() * point;
   switch (obstacle.shape) {
     case WrapShape::kSphere:
-      return (q.norm() - clearance) / obstacle.radii.x();
+      return {q.norm(), q.norm() / obstacle.radii.x()};
     case WrapShape::kCylinder:
-      return (q.head<2>().norm() - clearance) / obstacle.radii.x();
-    case WrapShape::kEllipsoid: {
-      const double k = q.cwiseQuotient(obstacle.radii).norm();
-      return q.norm() > 0 ? k * (1.0 - clearance / q.norm()) : 0.0;
-    }
+      return {q.head<2>().norm(), q.head<2>().norm() / obstacle.radii.x()};
+    case WrapShape::kEllipsoid:
+      return {q.norm(), q.cwiseQuotient(obstacle.radii).norm()};
   }
-  return 1.0;
+  return {};
+}
+
+// The largest factor the obstacle's size may be multiplied by, about its
+// centre, for `point` to lie `clearance` outside: ratio (1 - clearance / length).
+double allowed_scale(const WrapObstacle& obstacle, const Eigen::Vector3d& point, double clearance) {
+  const Radial r = radial(obstacle, point);
+  return r.length > 0 ? r.ratio * (1.0 - clearance / r.length) : 0.0;
 }
 
 }  // namespace
 
 double distance_outside(const WrapObstacle& obstacle, const Eigen::Vector3d& point) {
-  const Eigen::Vector3d q = obstacle.pose.inverse() * point;
-  switch (obstacle.shape) {
-    case WrapShape::kSphere:
-      return q.norm() - obstacle.radii.x();
-    case WrapShape::kCylinder:
-      return q.head<2>().norm() - obstacle.radii.x();
-    case WrapShape::kEllipsoid: {
-      const double k = q.cwiseQuotient(obstacle.radii).norm();
-      return k > 0 ? q.norm() * (1.0 - 1.0 / k) : -obstacle.radii.minCoeff();
-    }
-  }
-  return 0.0;
+  // length - length / ratio: the ray's part beyond the surface.
+  const Radial r = radial(obstacle, point);
+  if (r.ratio <= 0) return -obstacle.radii.minCoeff();
+  return r.length * (1.0 - 1.0 / r.ratio);
 }
 
 WrapObstacle fit_wrap_surface(const std::string& name, const std::string& bone, WrapShape shape,

@@ -34,12 +34,6 @@ const PathPoint* find_point(const Atlas& atlas, const std::string& name) {
   return nullptr;
 }
 
-const Joint* find_joint(const Atlas& atlas, const std::string& name) {
-  const auto found =
-      std::ranges::find_if(atlas.joints, [&](const Joint& joint) { return joint.name == name; });
-  return found == atlas.joints.end() ? nullptr : &*found;
-}
-
 // The first rotation axis of a joint that a coordinate drives (atlas frame);
 // the joint frame's z for a joint without such an axis.
 Eigen::Vector3d joint_axis(const Joint& joint) {
@@ -83,7 +77,7 @@ std::vector<WrapSurfaceFitReport> add_wrap_surfaces(
     if (!surface.around_joint.empty()) {
       // Around a joint the bone lies all round: the side picks its part.
       region.side = side;
-      const Joint* joint = find_joint(atlas, surface.around_joint);
+      const Joint* joint = atlas.find_joint(surface.around_joint);
       if (joint == nullptr) fail(surface, "no joint " + surface.around_joint + " in the atlas");
       region.centre = joint->child_frame.translation();
     } else {
@@ -95,7 +89,7 @@ std::vector<WrapSurfaceFitReport> add_wrap_surfaces(
     }
     std::optional<Eigen::Vector3d> axis;
     if (!surface.axis_of_joint.empty()) {
-      const Joint* joint = find_joint(atlas, surface.axis_of_joint);
+      const Joint* joint = atlas.find_joint(surface.axis_of_joint);
       if (joint == nullptr) fail(surface, "no joint " + surface.axis_of_joint + " in the atlas");
       axis = joint_axis(*joint);
     }

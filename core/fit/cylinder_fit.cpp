@@ -19,9 +19,7 @@ namespace {
 
 // A start frame whose z is `axis` (unit).
 Eigen::Matrix3d frame_along(const Eigen::Vector3d& axis) {
-  const Eigen::Vector3d helper =
-      std::abs(axis.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d x = (helper - helper.dot(axis) * axis).normalized();
+  const Eigen::Vector3d x = axis.unitOrthogonal();
   Eigen::Matrix3d frame;
   frame.col(0) = x;
   frame.col(1) = axis.cross(x);

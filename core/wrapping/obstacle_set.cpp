@@ -226,18 +226,20 @@ WrapResult wrap_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& s,
   const Quadrant quadrant = parse_quadrant(obstacle.quadrant, obstacle.shape);
   // Points on the surface or just outside it shrink the obstacle too (by
   // at most the margin), so the shrinking starts continuously.
-  const double nearest = std::min(size_ratio(p, obstacle), size_ratio(s, obstacle));
-  const double shrink = smooth_min(1.0, kShrinkMargin * nearest, kShrinkBlend);
-  if (shrink < 1.0 && options.shrink_to_inside_points) {
+  if (options.shrink_to_inside_points) {
+    const double nearest = std::min(size_ratio(p, obstacle), size_ratio(s, obstacle));
+    const double shrink = smooth_min(1.0, kShrinkMargin * nearest, kShrinkBlend);
     if (shrink < kSmallestShrink) return straight(p, s, true);
-    Obstacle smaller = obstacle;
-    smaller.radius *= shrink;
-    smaller.radii *= shrink;
-    WrapOptions plain = options;
-    plain.shrink_to_inside_points = false;
-    WrapResult result = wrap_segment(p, s, smaller, plain);
-    result.inside = nearest <= 1.0;
-    return result;
+    if (shrink < 1.0) {
+      Obstacle smaller = obstacle;
+      smaller.radius *= shrink;
+      smaller.radii *= shrink;
+      WrapOptions plain = options;
+      plain.shrink_to_inside_points = false;
+      WrapResult result = wrap_segment(p, s, smaller, plain);
+      result.inside = nearest <= 1.0;
+      return result;
+    }
   }
   switch (obstacle.shape) {
     case ObstacleShape::kSphere:
