@@ -87,6 +87,20 @@ nlohmann::json build_json(const atlas::AtlasBuildReport& report) {
                         {"radii_mm", {w.radii.x(), w.radii.y(), w.radii.z()}}});
   }
   json["wrap_surfaces"] = surfaces;
+  nlohmann::json structures = nlohmann::json::array();
+  for (const atlas::StructureBuildReport& s : report.structures) {
+    nlohmann::json gaps = nlohmann::json::object();
+    nlohmann::json overlaps = nlohmann::json::object();
+    for (const auto& [bone, gap] : s.gap_mm) gaps[bone] = gap;
+    for (const auto& [bone, overlap] : s.overlap_mm) overlaps[bone] = overlap;
+    structures.push_back({{"name", s.name},
+                          {"kind", s.kind},
+                          {"faces", s.faces},
+                          {"volume_mm3", s.volume_mm3},
+                          {"gap_to_bone_mm", gaps},
+                          {"overlap_with_bone_mm", overlaps}});
+  }
+  json["structures"] = structures;
   json["notes"] = report.notes;
   return json;
 }
@@ -136,6 +150,18 @@ void print_build(const atlas::AtlasBuildReport& report) {
               << " radii " << w.radii.x() << " " << w.radii.y() << " " << w.radii.z() << " mm, rms "
               << w.rms_mm << " mm over " << w.vertices << " vertices, x" << w.shrink
               << (w.shrunk_by.empty() ? "" : " (" + w.shrunk_by + ")") << '\n';
+  }
+  if (!report.structures.empty()) {
+    std::cout << "cartilages and ligaments (gap to / overlap with their bones):\n";
+  }
+  for (const atlas::StructureBuildReport& s : report.structures) {
+    std::cout << "  " << std::left << std::setw(30) << s.name << std::setw(10) << s.kind
+              << std::right;
+    for (std::size_t i = 0; i < s.gap_mm.size(); ++i) {
+      std::cout << "  " << s.gap_mm[i].first << " " << s.gap_mm[i].second << " / "
+                << s.overlap_mm[i].second << " mm";
+    }
+    std::cout << '\n';
   }
   for (const std::string& note : report.notes) std::cout << "note: " << note << '\n';
   std::cout << "built in " << report.seconds << " s\n";
@@ -269,6 +295,19 @@ nlohmann::json check_json(const atlas::AtlasCheckReport& report) {
                              {"overlap_mm", a.overlap_mm}});
   }
   anatomy["articulations"] = articulations;
+  nlohmann::json cartilages = nlohmann::json::array();
+  for (const atlas::CartilageContact& c : report.anatomy.cartilage_contacts) {
+    cartilages.push_back({{"articulation", c.articulation},
+                          {"cartilages", {c.a, c.b}},
+                          {"gap_mm", c.gap_mm},
+                          {"overlap_mm", c.overlap_mm}});
+  }
+  anatomy["cartilage_contacts"] = cartilages;
+  nlohmann::json attached = nlohmann::json::array();
+  for (const atlas::StructureAttachment& a : report.anatomy.structure_attachments) {
+    attached.push_back({{"structure", a.structure}, {"bone", a.bone}, {"gap_mm", a.gap_mm}});
+  }
+  anatomy["structures_on_bones"] = attached;
   nlohmann::json contacts = nlohmann::json::array();
   for (const atlas::BoneContact& c : report.anatomy.contacts) {
     contacts.push_back({{"bones", {c.a, c.b}},
@@ -308,6 +347,16 @@ void print_check(const atlas::AtlasCheckReport& report) {
     std::cout << std::left << std::setw(22) << a.name << std::setw(40) << (a.a + " - " + a.b)
               << std::right << std::setw(10) << std::setprecision(2) << a.gap_mm << std::setw(14)
               << a.overlap_mm << '\n';
+  }
+  if (!report.anatomy.cartilage_contacts.empty()) {
+    std::cout << '\n'
+              << std::left << std::setw(22) << "cartilage contact" << std::setw(58) << "cartilages"
+              << std::right << std::setw(10) << "gap mm" << std::setw(14) << "overlap mm" << '\n';
+  }
+  for (const atlas::CartilageContact& c : report.anatomy.cartilage_contacts) {
+    std::cout << std::left << std::setw(22) << c.articulation << std::setw(58)
+              << (c.a + " - " + c.b) << std::right << std::setw(10) << std::setprecision(2)
+              << c.gap_mm << std::setw(14) << c.overlap_mm << '\n';
   }
   double deepest = 0.0;
   std::string deepest_pair = "none";

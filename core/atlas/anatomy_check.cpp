@@ -1,5 +1,6 @@
 #include "core/atlas/anatomy_check.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -42,10 +43,70 @@ const BoneContact* find_contact(const std::vector<BoneContact>& contacts, const 
   return nullptr;
 }
 
+Eigen::AlignedBox3d box_of(const mesh::IndexedMesh& surface, double grown_by) {
+  Eigen::AlignedBox3d box;
+  for (Eigen::Index i = 0; i < surface.V.rows(); ++i) box.extend(surface.V.row(i).transpose());
+  box.min().array() -= grown_by;
+  box.max().array() += grown_by;
+  return box;
+}
+
+// The cartilages (with a surface at hand) on any of `sides` bones.
+std::vector<std::string> cartilages_on(const Atlas& atlas,
+                                       const std::map<std::string, mesh::IndexedMesh>& structures,
+                                       const std::set<std::string>& sides) {
+  std::vector<std::string> names;
+  for (const Structure& structure : atlas.structures) {
+    if (structure.kind != StructureKind::kCartilage || structure.bones.empty()) continue;
+    if (sides.contains(structure.bones.front()) && structures.contains(structure.name)) {
+      names.push_back(structure.name);
+    }
+  }
+  return names;
+}
+
+// The facing cartilage pairs of one articulation, measured and held
+// against the limits.
+void check_cartilages(const std::string& articulation, const std::vector<std::string>& one,
+                      const std::vector<std::string>& other,
+                      const std::map<std::string, mesh::IndexedMesh>& structures,
+                      const AnatomyLimits& limits, AnatomyReport& report,
+                      std::vector<std::string>& problems) {
+  if (one.empty() || other.empty()) return;
+  bool facing = false;
+  for (const std::string& a : one) {
+    const mesh::IndexedMesh& a_surface = structures.at(a);
+    const Eigen::AlignedBox3d a_box = box_of(a_surface, 0.5 * limits.cartilage_reach_mm);
+    for (const std::string& b : other) {
+      const mesh::IndexedMesh& b_surface = structures.at(b);
+      if (!a_box.intersects(box_of(b_surface, 0.5 * limits.cartilage_reach_mm))) continue;
+      facing = true;
+      const BoneContact contact = contact_between({a, &a_surface}, {b, &b_surface});
+      report.cartilage_contacts.push_back({articulation, a, b, contact.gap_mm, contact.overlap_mm});
+      if (contact.gap_mm > limits.max_cartilage_gap_mm) {
+        problems.push_back("articulation " + articulation + ": cartilages " + a + " and " + b +
+                           " are " + mm_text(contact.gap_mm) + " apart (at most " +
+                           mm_text(limits.max_cartilage_gap_mm) + " allowed)");
+      }
+      if (contact.overlap_mm > limits.max_cartilage_overlap_mm) {
+        problems.push_back("articulation " + articulation + ": cartilages " + a + " and " + b +
+                           " overlap by " + mm_text(contact.overlap_mm) + " (at most " +
+                           mm_text(limits.max_cartilage_overlap_mm) + " allowed)");
+      }
+    }
+  }
+  if (!facing) {
+    problems.push_back("articulation " + articulation + ": no cartilage of " + one.front() +
+                       "'s side faces one of the other side within " +
+                       mm_text(limits.cartilage_reach_mm) + " (a displaced bone or cartilage?)");
+  }
+}
+
 }  // namespace
 
 AnatomyReport check_anatomy(const Atlas& atlas,
                             const std::map<std::string, mesh::IndexedMesh>& bones,
+                            const std::map<std::string, mesh::IndexedMesh>& structures,
                             const AnatomyLimits& limits, std::vector<std::string>& problems) {
   AnatomyReport report;
   std::vector<NamedSurface> surfaces;
@@ -114,6 +175,8 @@ AnatomyReport check_anatomy(const Atlas& atlas,
                          mm_text(limits.max_joint_gap_mm) + " allowed)");
     }
     report.articulations.push_back(best);
+    check_cartilages(name, cartilages_on(atlas, structures, one),
+                     cartilages_on(atlas, structures, other), structures, limits, report, problems);
   };
   const auto members = [&](const std::string& side) {
     std::set<std::string> names;
@@ -140,6 +203,22 @@ AnatomyReport check_anatomy(const Atlas& atlas,
     if (femurs.empty()) continue;
     const std::string side = patella.name.ends_with("_l") ? "_l" : "_r";
     add_articulation("patellofemoral" + side, {patella.name}, femurs);
+  }
+
+  for (const Structure& structure : atlas.structures) {
+    const auto surface = structures.find(structure.name);
+    if (surface == structures.end()) continue;
+    for (const std::string& bone : structure.bones) {
+      if (!bones.contains(bone)) continue;
+      const double gap =
+          contact_between({structure.name, &surface->second}, {bone, &bones.at(bone)}).gap_mm;
+      report.structure_attachments.push_back({structure.name, bone, gap});
+      if (gap > limits.max_structure_gap_mm) {
+        problems.push_back(std::string(structure_kind_name(structure.kind)) + " " + structure.name +
+                           " is " + mm_text(gap) + " from its bone " + bone + " (at most " +
+                           mm_text(limits.max_structure_gap_mm) + " allowed)");
+      }
+    }
   }
 
   const Landmark* head = atlas.find_landmark("femoral_head_centre_r");

@@ -63,7 +63,17 @@ constexpr std::array<std::pair<FibreArchitecture, std::string_view>, 4> kArchite
     {FibreArchitecture::kCurved, "curved"},
 }};
 
+constexpr std::array<std::pair<StructureKind, std::string_view>, 2> kStructureKinds = {{
+    {StructureKind::kCartilage, "cartilage"},
+    {StructureKind::kLigament, "ligament"},
+}};
+
 }  // namespace
+
+std::string_view structure_kind_name(StructureKind kind) { return to_name(kind, kStructureKinds); }
+std::optional<StructureKind> structure_kind_from_name(std::string_view name) {
+  return from_name(name, kStructureKinds);
+}
 
 std::string_view joint_type_name(JointType type) { return to_name(type, kJointTypes); }
 std::optional<JointType> joint_type_from_name(std::string_view name) {
@@ -96,6 +106,9 @@ const Marker* Atlas::find_marker(std::string_view element) const {
 const Region* Atlas::find_region(std::string_view element) const {
   return find_named(regions, element);
 }
+const Structure* Atlas::find_structure(std::string_view element) const {
+  return find_named(structures, element);
+}
 Bone* Atlas::find_bone(std::string_view element) { return find_named(bones, element); }
 Muscle* Atlas::find_muscle(std::string_view element) { return find_named(muscles, element); }
 
@@ -103,6 +116,7 @@ std::vector<std::string> Atlas::find_by_tag(std::string_view tag) const {
   std::vector<std::string> names;
   collect_tagged(bones, tag, names);
   collect_tagged(muscles, tag, names);
+  collect_tagged(structures, tag, names);
   collect_tagged(landmarks, tag, names);
   collect_tagged(regions, tag, names);
   return names;

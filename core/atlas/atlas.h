@@ -160,6 +160,23 @@ struct Muscle {
   double pennation_angle_rad = 0.0;
 };
 
+// A passive structure carried by the bones: a cartilage covers one bone (the
+// joint's contact surface), a ligament runs from one bone to another. Both
+// are scaled with their bones and moved by them (structure_carriage.h); the
+// muscles and action lines do not depend on them.
+enum class StructureKind { kCartilage, kLigament };
+std::string_view structure_kind_name(StructureKind kind);
+std::optional<StructureKind> structure_kind_from_name(std::string_view name);
+
+struct Structure {
+  std::string name;  // e.g. "femur_distal_cartilage_r"
+  StructureKind kind = StructureKind::kCartilage;
+  std::vector<std::string> tags;
+  std::vector<MeshLevel> meshes;  // "full" first
+  // Cartilage: the bone it covers. Ligament: the bones it joins, [from, to].
+  std::vector<std::string> bones;
+};
+
 struct Landmark {
   std::string name;  // e.g. "femoral_head_centre_r"
   std::string bone;
@@ -181,6 +198,7 @@ struct Region {
   std::vector<std::string> tags;
   std::vector<std::string> bones;
   std::vector<std::string> muscles;
+  std::vector<std::string> structures;
 };
 
 struct Atlas {
@@ -192,6 +210,7 @@ struct Atlas {
   std::vector<Bone> bones;
   std::vector<Joint> joints;
   std::vector<Muscle> muscles;
+  std::vector<Structure> structures;
   std::vector<Landmark> landmarks;
   std::vector<Marker> markers;
 
@@ -202,10 +221,11 @@ struct Atlas {
   [[nodiscard]] const Landmark* find_landmark(std::string_view element) const;
   [[nodiscard]] const Marker* find_marker(std::string_view element) const;
   [[nodiscard]] const Region* find_region(std::string_view element) const;
+  [[nodiscard]] const Structure* find_structure(std::string_view element) const;
   [[nodiscard]] Bone* find_bone(std::string_view element);
   [[nodiscard]] Muscle* find_muscle(std::string_view element);
 
-  // Names of every bone, muscle, landmark and region carrying `tag`.
+  // Names of every bone, muscle, structure, landmark and region carrying `tag`.
   [[nodiscard]] std::vector<std::string> find_by_tag(std::string_view tag) const;
 };
 

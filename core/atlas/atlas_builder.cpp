@@ -13,6 +13,7 @@
 #include "core/atlas/bone_registration.h"
 #include "core/atlas/muscle_cleanup.h"
 #include "core/atlas/opensim_mapping.h"
+#include "core/atlas/structure_build.h"
 #include "core/atlas/surface_line.h"
 #include "core/atlas/wrap_surfaces.h"
 #include "core/errors.h"
@@ -134,9 +135,10 @@ class Builder {
   opensim::OsimModel model_;
   BodyMaps maps_;
   double midline_x_ = 0.0;
-  std::map<std::string, mesh::IndexedMesh> bone_meshes_;     // full resolution, atlas (mm)
-  std::map<std::string, mesh::IndexedMesh> muscle_meshes_;   // full resolution, atlas (mm)
-  std::map<std::string, Eigen::Vector3d> marker_positions_;  // atlas (mm)
+  std::map<std::string, mesh::IndexedMesh> bone_meshes_;       // full resolution, atlas (mm)
+  std::map<std::string, mesh::IndexedMesh> muscle_meshes_;     // full resolution, atlas (mm)
+  std::map<std::string, mesh::IndexedMesh> structure_meshes_;  // full resolution, atlas (mm)
+  std::map<std::string, Eigen::Vector3d> marker_positions_;    // atlas (mm)
   Atlas atlas_;
 };
 
@@ -712,6 +714,10 @@ void Builder::write(const std::filesystem::path& out_dir) {
     muscle.meshes =
         write_levels(out_dir, muscle.name, muscle_meshes_.at(muscle.name), recipe_.lod_faces);
   }
+  for (Structure& structure : atlas_.structures) {
+    structure.meshes = write_levels(out_dir, structure.name, structure_meshes_.at(structure.name),
+                                    recipe_.lod_faces);
+  }
   write_atlas_manifest(atlas_, out_dir);
 }
 
@@ -732,6 +738,10 @@ AtlasBuildReport Builder::run(const std::filesystem::path& out_dir) {
     atlas_.provenance.push_back("muscle " + muscle.name + ": " + muscle.file +
                                 (muscle.mirror ? " (mirrored)" : ""));
   }
+  for (const RecipeStructure& structure : recipe_.structures) {
+    atlas_.provenance.push_back(std::string(structure_kind_name(structure.kind)) + " " +
+                                structure.name + ": " + structure.file);
+  }
   read_model();
   read_atlas_frame_bones();
   register_bodies();
@@ -743,7 +753,7 @@ AtlasBuildReport Builder::run(const std::filesystem::path& out_dir) {
   clean_and_attach();
   report_.wrap_surfaces = add_wrap_surfaces(recipe_, bone_meshes_, atlas_);
   for (const RecipeRegion& recipe_region : recipe_.regions) {
-    Region region{recipe_region.name, recipe_region.tags, {}, {}};
+    Region region{recipe_region.name, recipe_region.tags, {}, {}, {}};
     for (const RecipeBone& bone : recipe_.bones) {
       if (bone.region == region.name) region.bones.push_back(bone.name);
     }
@@ -752,6 +762,12 @@ AtlasBuildReport Builder::run(const std::filesystem::path& out_dir) {
     }
     atlas_.regions.push_back(std::move(region));
   }
+  report_.structures = add_structures(
+      recipe_,
+      [&](const std::string& file, const std::string& field) {
+        return mesh::read_mesh(data_file(options_, file, field));
+      },
+      bone_meshes_, {}, atlas_, structure_meshes_);
 
   // Written beside the target, then swapped in: a failed build never leaves
   // half an atlas where a complete one was.

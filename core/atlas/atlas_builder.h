@@ -20,7 +20,9 @@
 //      action lines are fitted into their muscle (action_line_fit.h),
 //      attachment areas are found where each muscle meets a bone near its
 //      action lines' ends, landmarks are placed, lower resolutions made;
-//   5. meshes (binary PLY) and atlas.yaml are written.
+//   5. cartilages and ligaments are read and measured against their bones
+//      (structure_build.h);
+//   6. meshes (binary PLY) and atlas.yaml are written.
 //
 // Deterministic: the same recipe and data give byte-identical files.
 
@@ -30,6 +32,7 @@
 
 #include "core/atlas/atlas.h"
 #include "core/atlas/atlas_recipe.h"
+#include "core/atlas/structure_build.h"
 #include "core/atlas/wrap_surface_fit.h"
 
 namespace mmm::atlas {
@@ -80,6 +83,7 @@ struct AtlasBuildReport {
   std::vector<JointBuildReport> joints;
   std::vector<ActionLineBuildReport> action_lines;
   std::vector<WrapSurfaceFitReport> wrap_surfaces;
+  std::vector<StructureBuildReport> structures;
   std::vector<std::string> notes;  // what was skipped or approximated, one sentence each
   double seconds = 0.0;
 };

@@ -128,6 +128,9 @@ AtlasCheckReport check_atlas(const std::filesystem::path& dir, const AtlasCheckO
   }
   for (const Bone& bone : atlas.bones) check_levels(dir, bone.name, bone.meshes, report);
   for (const Muscle& muscle : atlas.muscles) check_levels(dir, muscle.name, muscle.meshes, report);
+  for (const Structure& structure : atlas.structures) {
+    check_levels(dir, structure.name, structure.meshes, report);
+  }
 
   std::map<std::string, mesh::IndexedMesh> bone_surfaces;
   for (const Bone& bone : atlas.bones) {
@@ -137,7 +140,16 @@ AtlasCheckReport check_atlas(const std::filesystem::path& dir, const AtlasCheckO
       // Already reported by check_levels.
     }
   }
-  report.anatomy = check_anatomy(atlas, bone_surfaces, options.anatomy, report.problems);
+  std::map<std::string, mesh::IndexedMesh> structure_surfaces;
+  for (const Structure& structure : atlas.structures) {
+    try {
+      structure_surfaces[structure.name] = load_mesh(dir, structure.meshes);
+    } catch (const std::exception&) {
+      // Already reported by check_levels.
+    }
+  }
+  report.anatomy =
+      check_anatomy(atlas, bone_surfaces, structure_surfaces, options.anatomy, report.problems);
   // Bones' signed distances, built once.
   std::map<std::string, std::unique_ptr<mesh::SignedDistance>> bones;
   for (const auto& [name, surface] : bone_surfaces) {

@@ -1,8 +1,8 @@
 #pragma once
 // Is an atlas fit to start a study from? `mmm atlas check` runs this and
 // fails when any answer is no:
-//   - every bone and muscle mesh (every level) is a closed 2-manifold,
-//     consistently oriented;
+//   - every bone, muscle, cartilage and ligament mesh (every level) is a
+//     closed 2-manifold, consistently oriented outward;
 //   - no muscle enters a bone deeper than `max_penetration_mm` at rest;
 //   - the fibre part of every action line lies at least `min_inside_fraction`
 //     inside its own muscle: the inside length (the polyline sampled every
@@ -12,7 +12,8 @@
 //     patellar tendon of the quadriceps);
 //   - the bones fit together as in a person (anatomy_check.h: no bone in
 //     another, none away from its neighbours, joints closed, the femoral
-//     head in the acetabulum);
+//     head in the acetabulum, the cartilages of each joint meeting, every
+//     cartilage and ligament on its bones);
 //   - the required landmarks exist (kRequiredLandmarks);
 //   - every reference resolves (read_atlas checks that; a failure is
 //     reported as a problem here rather than thrown).
@@ -37,7 +38,7 @@ struct AtlasCheckOptions {
 };
 
 struct MeshHealth {
-  std::string element;  // bone or muscle name
+  std::string element;  // bone, muscle or structure name
   std::string level;    // "full", "lod1", ...
   int faces = 0;
   bool closed = false;

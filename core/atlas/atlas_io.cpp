@@ -224,6 +224,10 @@ class ManifestWriter {
     block_list(atlas.joints, [&](const Joint& joint) { write_joint(joint); });
     key("muscles");
     block_list(atlas.muscles, [&](const Muscle& muscle) { write_muscle(muscle); });
+    if (!atlas.structures.empty()) {
+      key("structures");
+      block_list(atlas.structures, [&](const Structure& structure) { write_structure(structure); });
+    }
     key("landmarks");
     block_list(atlas.landmarks, [&](const Landmark& landmark) { write_landmark(landmark); });
     key("markers");
@@ -364,6 +368,25 @@ class ManifestWriter {
     texts(region.bones);
     key("muscles");
     texts(region.muscles);
+    if (!region.structures.empty()) {
+      key("structures");
+      texts(region.structures);
+    }
+    out_ << YAML::EndMap;
+  }
+
+  void write_structure(const Structure& structure) {
+    out_ << YAML::BeginMap;
+    key("name");
+    text(structure.name);
+    key("kind");
+    out_ << std::string(structure_kind_name(structure.kind));
+    key("tags");
+    texts(structure.tags);
+    key("bones");
+    texts(structure.bones);
+    key("meshes");
+    mesh_levels(structure.meshes);
     out_ << YAML::EndMap;
   }
 
@@ -623,7 +646,7 @@ std::string item_path(const std::string& path, std::size_t index) {
   return path + "[" + std::to_string(index) + "]";
 }
 
-enum class RefKind { kBone, kJoint, kMuscle, kCoordinate };
+enum class RefKind { kBone, kJoint, kMuscle, kCoordinate, kStructure };
 
 struct Reference {
   RefKind kind;
@@ -679,10 +702,14 @@ class AtlasReader {
       for (const Coordinate& c : joint.coordinates) names[RefKind::kCoordinate].push_back(c.name);
     }
     for (const Muscle& muscle : atlas.muscles) names[RefKind::kMuscle].push_back(muscle.name);
+    for (const Structure& structure : atlas.structures) {
+      names[RefKind::kStructure].push_back(structure.name);
+    }
     static const std::map<RefKind, std::pair<std::string, std::string>> kWords = {
         {RefKind::kBone, {"bone", "bones"}},
         {RefKind::kJoint, {"joint", "joints"}},
         {RefKind::kMuscle, {"muscle", "muscles"}},
+        {RefKind::kStructure, {"structure", "structures"}},
         {RefKind::kCoordinate, {"coordinate", "coordinates"}}};
     for (const Reference& ref : references_) {
       const std::vector<std::string>& candidates = names[ref.kind];
@@ -1165,6 +1192,7 @@ Region read_region(AtlasReader& r, const Value& v) {
   m.texts("tags", region.tags, Need::kOptional);
   refer_all(r, m, "bones", region.bones, RefKind::kBone);
   refer_all(r, m, "muscles", region.muscles, RefKind::kMuscle);
+  refer_all(r, m, "structures", region.structures, RefKind::kStructure);
   m.finish();
   return region;
 }
@@ -1480,6 +1508,34 @@ Muscle read_muscle(AtlasReader& r, const Value& v) {
   return muscle;
 }
 
+Structure read_structure(AtlasReader& r, const Value& v) {
+  Structure structure;
+  MapReader m(r, v);
+  if (!m.valid()) return structure;
+  if (const std::optional<Value> name = m.name("name", structure.name, Need::kRequired)) {
+    r.declare("structure", structure.name, *name);
+  }
+  const std::vector<std::string> kinds = {"cartilage", "ligament"};
+  const auto kind = m.choice("kind", kinds, "structure kind", Need::kRequired);
+  if (kind) structure.kind = *structure_kind_from_name(kinds[*kind]);
+  m.texts("tags", structure.tags, Need::kOptional);
+  const std::optional<Value> bones = m.get("bones", Need::kRequired);
+  refer_all(r, m, "bones", structure.bones, RefKind::kBone);
+  if (bones && kind) {
+    const std::size_t wanted = structure.kind == StructureKind::kCartilage ? 1 : 2;
+    if (structure.bones.size() != wanted) {
+      r.report(*bones, structure.kind == StructureKind::kCartilage
+                           ? "a cartilage names the one bone it covers"
+                           : "a ligament names the two bones it joins, [from, to]");
+    } else if (wanted == 2 && structure.bones[0] == structure.bones[1]) {
+      r.report(*bones, "a ligament joins two different bones");
+    }
+  }
+  structure.meshes = read_mesh_levels(r, m);
+  m.finish();
+  return structure;
+}
+
 Landmark read_landmark(AtlasReader& r, const Value& v) {
   Landmark landmark;
   MapReader m(r, v);
@@ -1606,6 +1662,11 @@ std::vector<Problem> parse_manifest(const std::string& text, Atlas& atlas) {
   });
   read_list(r, m, "muscles", atlas.muscles, Need::kOptional,
             [&](const Value& item) { return read_muscle(r, item); });
+  std::vector<Value> structure_items;
+  read_list(r, m, "structures", atlas.structures, Need::kOptional, [&](const Value& item) {
+    structure_items.push_back(item);
+    return read_structure(r, item);
+  });
   read_list(r, m, "landmarks", atlas.landmarks, Need::kOptional,
             [&](const Value& item) { return read_landmark(r, item); });
   read_list(r, m, "markers", atlas.markers, Need::kOptional,
@@ -1613,6 +1674,14 @@ std::vector<Problem> parse_manifest(const std::string& text, Atlas& atlas) {
   m.finish();
   r.resolve(atlas);
   check_tree(r, atlas, bone_items, joint_items);
+  // Meshes are kept per element name: a structure is named unlike any bone or muscle.
+  for (std::size_t i = 0; i < atlas.structures.size() && i < structure_items.size(); ++i) {
+    const std::string& name = atlas.structures[i].name;
+    if (atlas.find_bone(name) != nullptr || atlas.find_muscle(name) != nullptr) {
+      r.report(structure_items[i].node["name"].Mark(), structure_items[i].path + ".name",
+               "'" + name + "' is already the name of a bone or muscle");
+    }
+  }
   return r.problems();
 }
 

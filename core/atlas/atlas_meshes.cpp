@@ -23,6 +23,9 @@ std::vector<MeshJob> mesh_jobs(const Atlas& atlas) {
   for (const Muscle& muscle : atlas.muscles) {
     for (const MeshLevel& level : muscle.meshes) jobs.push_back({muscle.name, &level});
   }
+  for (const Structure& structure : atlas.structures) {
+    for (const MeshLevel& level : structure.meshes) jobs.push_back({structure.name, &level});
+  }
   return jobs;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// Every mesh of an atlas in memory: element (bone or muscle) -> level
+// Every mesh of an atlas in memory: element (bone, muscle or structure) -> level
 // ("full", "lod1", ...) -> mesh, read from and written to the atlas folder
 // at the files its MeshLevels name.
 
@@ -14,7 +14,7 @@ namespace mmm::atlas {
 
 using AtlasMeshes = std::map<std::string, std::map<std::string, mesh::IndexedMesh>>;
 
-// Reads every level of every bone and muscle (threads > 1: in parallel).
+// Reads every level of every bone, muscle and structure (threads > 1: in parallel).
 // Throws IoError naming the file that cannot be read.
 AtlasMeshes read_atlas_meshes(const Atlas& atlas, const std::filesystem::path& dir,
                               int threads = 2);

@@ -226,7 +226,7 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
       root, "(top)",
       {"mmm_atlas_recipe", "name", "description", "frame", "opensim", "midline", "lod_faces",
        "penetration_tolerance_mm", "attachment_distance_mm", "attachment_radius_mm", "regions",
-       "bones", "registration", "muscles", "landmarks", "wrap_surfaces"});
+       "bones", "registration", "muscles", "structures", "landmarks", "wrap_surfaces"});
   AtlasRecipe recipe;
   recipe.source = file;
   const double format = reader.number(root, "mmm_atlas_recipe", "(top)", -1, -1e9, 1e9);
@@ -422,6 +422,47 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
     recipe.muscles.push_back(std::move(muscle));
   }
   check_unique(reader, root, "muscles", recipe.muscles);
+
+  index = 0;
+  for (const YAML::Node& item :
+       reader.items(root, "structures", {"name", "kind", "file", "bones", "region", "tags"})) {
+    const std::string field = "structures[" + std::to_string(index++) + "]";
+    RecipeStructure structure;
+    structure.name = reader.text(item, "name", field, true);
+    const std::string kind = reader.text(item, "kind", field, true);
+    const auto parsed = structure_kind_from_name(kind);
+    if (!parsed) {
+      reader.fail(item["kind"], field + ".kind",
+                  "unknown kind '" + kind + "' (expected cartilage or ligament)");
+    }
+    structure.kind = *parsed;
+    structure.file = reader.text(item, "file", field, true);
+    structure.bones = reader.texts(item, "bones", field);
+    const std::size_t wanted = structure.kind == StructureKind::kCartilage ? 1 : 2;
+    if (structure.bones.size() != wanted ||
+        (wanted == 2 && structure.bones[0] == structure.bones[1])) {
+      reader.fail(item["bones"].IsDefined() ? item["bones"] : item, field + ".bones",
+                  wanted == 1 ? "a cartilage names the one bone it covers: [bone]"
+                              : "a ligament names the two different bones it joins: [from, to]");
+    }
+    for (const std::string& bone : structure.bones) {
+      if (!has_bone(bone)) {
+        reader.fail(item["bones"], field + ".bones", "unknown bone '" + bone + "'");
+      }
+    }
+    const auto clashes = [&](const auto& list) {
+      return std::ranges::any_of(list, [&](const auto& e) { return e.name == structure.name; });
+    };
+    if (clashes(recipe.bones) || clashes(recipe.muscles)) {
+      reader.fail(item["name"], field + ".name",
+                  "'" + structure.name + "' is already the name of a bone or muscle");
+    }
+    structure.region = reader.text(item, "region", field);
+    structure.tags = reader.texts(item, "tags", field);
+    check_region(item, field, structure.region);
+    recipe.structures.push_back(std::move(structure));
+  }
+  check_unique(reader, root, "structures", recipe.structures);
 
   index = 0;
   for (const YAML::Node& item :

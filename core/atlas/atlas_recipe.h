@@ -16,6 +16,8 @@
 //     femur_r: {method: head_and_condyles, head: ..., condyles: ...}
 //   muscles:
 //     - {name: gluteus_medius_r, file: ..., action_lines: [glut_med1_r, ...], ...}
+//   structures:                          # cartilages and ligaments, carried by bones
+//     - {name: acl_r, kind: ligament, file: ..., bones: [femur_r, tibia_r]}
 //   landmarks: ...
 //   wrap_surfaces:                       # fitted to the bones, see wrap_surface_fit.h
 //     - {name: gastroc_at_condyles_r, bone: femur_r, shape: cylinder, around_joint: knee_r,
@@ -94,6 +96,18 @@ struct RecipeMuscle {
   std::vector<std::string> tags;
 };
 
+// A cartilage or ligament surface (already in the atlas frame, mm), carried
+// by its bone(s): a cartilage names the bone it covers, a ligament the two
+// it joins.
+struct RecipeStructure {
+  std::string name;
+  StructureKind kind = StructureKind::kCartilage;
+  std::string file;
+  std::vector<std::string> bones;
+  std::string region;
+  std::vector<std::string> tags;
+};
+
 // Named landmarks: how each is found.
 struct RecipeLandmark {
   std::string name;
@@ -159,6 +173,7 @@ struct AtlasRecipe {
   std::vector<RecipeBone> bones;
   std::vector<RecipeRegistration> registrations;
   std::vector<RecipeMuscle> muscles;
+  std::vector<RecipeStructure> structures;
   std::vector<RecipeLandmark> landmarks;
   std::vector<RecipeWrapSurface> wrap_surfaces;
 };

@@ -238,7 +238,21 @@ Atlas synthetic_atlas(const fs::path& dir) {
   thigh.tags = {"right", "thigh"};
   thigh.bones = {"femur_r"};
   thigh.muscles = {"vastus_intermedius_r"};
+  thigh.structures = {"collateral_ligament_r"};
   atlas.regions = {pelvis_region, thigh};
+
+  Structure ligament;
+  ligament.name = "collateral_ligament_r";
+  ligament.kind = StructureKind::kLigament;
+  ligament.tags = {"ligament", "right"};
+  ligament.bones = {"femur_r", "tibia_r"};
+  ligament.meshes = {
+      write_level(dir, ligament.name, "full", mesh::make_box({100, -2, -480}, {104, 2, -400}))};
+  Structure cartilage;
+  cartilage.name = "femur_distal_cartilage_r";
+  cartilage.kind = StructureKind::kCartilage;
+  cartilage.bones = {"femur_r"};
+  atlas.structures = {ligament, cartilage};
   return atlas;
 }
 
@@ -315,6 +329,7 @@ void expect_same_atlas(const Atlas& a, const Atlas& b) {
     EXPECT_EQ(a.regions[i].tags, b.regions[i].tags);
     EXPECT_EQ(a.regions[i].bones, b.regions[i].bones);
     EXPECT_EQ(a.regions[i].muscles, b.regions[i].muscles);
+    EXPECT_EQ(a.regions[i].structures, b.regions[i].structures);
   }
   ASSERT_EQ(a.bones.size(), b.bones.size());
   for (std::size_t i = 0; i < a.bones.size(); ++i) {
@@ -419,6 +434,18 @@ void expect_same_atlas(const Atlas& a, const Atlas& b) {
     EXPECT_EQ(a.landmarks[i].tags, b.landmarks[i].tags);
     EXPECT_EQ(a.landmarks[i].description, b.landmarks[i].description);
   }
+  ASSERT_EQ(a.structures.size(), b.structures.size());
+  for (std::size_t i = 0; i < a.structures.size(); ++i) {
+    EXPECT_EQ(a.structures[i].name, b.structures[i].name);
+    EXPECT_EQ(a.structures[i].kind, b.structures[i].kind);
+    EXPECT_EQ(a.structures[i].tags, b.structures[i].tags);
+    EXPECT_EQ(a.structures[i].bones, b.structures[i].bones);
+    ASSERT_EQ(a.structures[i].meshes.size(), b.structures[i].meshes.size());
+    for (std::size_t k = 0; k < a.structures[i].meshes.size(); ++k) {
+      EXPECT_EQ(a.structures[i].meshes[k].file, b.structures[i].meshes[k].file);
+      EXPECT_EQ(a.structures[i].meshes[k].faces, b.structures[i].meshes[k].faces);
+    }
+  }
   ASSERT_EQ(a.markers.size(), b.markers.size());
   for (std::size_t i = 0; i < a.markers.size(); ++i) {
     EXPECT_EQ(a.markers[i].name, b.markers[i].name);
@@ -468,11 +495,12 @@ TEST(AtlasIoTest, FindByTagAndNameAfterReading) {
   const test::ScratchDir dir("atlas_io_tags");
   write_atlas_manifest(synthetic_atlas(dir.path()), dir.path());
   const Atlas atlas = read_atlas(dir.path());
-  // Bones, then muscles, landmarks, regions, each in manifest order.
-  EXPECT_EQ(atlas.find_by_tag("right"),
-            (std::vector<std::string>{"femur_r", "tibia_r", "vastus_intermedius_r",
-                                      "femoral_head_centre_r", "patella_centre_r", "ankle_centre_r",
-                                      "asis_r", "right_thigh"}));
+  // Bones, then muscles, structures, landmarks, regions, each in manifest order.
+  EXPECT_EQ(
+      atlas.find_by_tag("right"),
+      (std::vector<std::string>{"femur_r", "tibia_r", "vastus_intermedius_r",
+                                "collateral_ligament_r", "femoral_head_centre_r",
+                                "patella_centre_r", "ankle_centre_r", "asis_r", "right_thigh"}));
   EXPECT_EQ(atlas.find_by_tag("quadriceps"), std::vector<std::string>{"vastus_intermedius_r"});
   EXPECT_TRUE(atlas.find_by_tag("left").empty());
   for (const std::string_view name : kRequiredLandmarks) {
@@ -485,6 +513,10 @@ TEST(AtlasIoTest, FindByTagAndNameAfterReading) {
   EXPECT_EQ(atlas.find_region("right_thigh")->muscles,
             std::vector<std::string>{"vastus_intermedius_r"});
   EXPECT_EQ(atlas.find_bone("femr_r"), nullptr);
+  ASSERT_NE(atlas.find_structure("collateral_ligament_r"), nullptr);
+  EXPECT_EQ(atlas.find_structure("collateral_ligament_r")->kind, StructureKind::kLigament);
+  EXPECT_EQ(atlas.find_structure("femur_distal_cartilage_r")->bones,
+            std::vector<std::string>{"femur_r"});
 }
 
 TEST(AtlasIoTest, ReadFunctionsEvaluateLikeTheOriginals) {
@@ -541,8 +573,9 @@ TEST(AtlasIoTest, AtlasCheckReadsTheWrittenAtlasAndEveryMeshLevel) {
   const test::ScratchDir dir("atlas_io_check");
   write_atlas_manifest(synthetic_atlas(dir.path()), dir.path());
   const AtlasCheckReport report = check_atlas(dir.path());
-  // pelvis 1 level, femur_r 2, tibia_r 1, the muscle 1.
-  ASSERT_EQ(report.meshes.size(), 5U);
+  // pelvis 1 level, femur_r 2, tibia_r 1, the muscle 1, the ligament 1 (the
+  // cartilage has none: a problem of its own, not a mesh).
+  ASSERT_EQ(report.meshes.size(), 6U);
   for (const MeshHealth& health : report.meshes) {
     EXPECT_TRUE(health.closed && health.manifold && health.oriented)
         << health.element << " " << health.level;
@@ -625,6 +658,8 @@ landmarks:
   - {name: asis_r, bone: pelvis, position: [10, 0, 0]}
 markers:
   - {name: R.ASIS, bone: pelvis, position: [10, 5, 0], fixed: true}
+structures:
+  - {name: hip_ligament_r, kind: ligament, bones: [pelvis, femur_r]}
 )";
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
@@ -760,6 +795,18 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"AbsoluteMeshPath", "file: meshes/pelvis.ply", "file: /etc/pelvis.ply",
                   "line 6, column 34: bones[0].meshes[0].file: '/etc/pelvis.ply' must be a "
                   "relative path inside the atlas folder (no leading / and no ..)"},
+        Malformed{"LigamentWithOneBone", "bones: [pelvis, femur_r]", "bones: [femur_r]",
+                  "line 38, column 51: structures[0].bones: a ligament names the two bones it "
+                  "joins, [from, to]"},
+        Malformed{"StructureNamedLikeABone", "name: hip_ligament_r", "name: femur_r",
+                  "line 38, column 12: structures[0].name: 'femur_r' is already the name of a "
+                  "bone or muscle"},
+        Malformed{"UnknownStructureKind", "kind: ligament", "kind: tendon",
+                  "line 38, column 34: structures[0].kind: unknown structure kind 'tendon' "
+                  "(expected one of: cartilage, ligament)"},
+        Malformed{"StructureOnAnUnknownBone", "bones: [pelvis, femur_r]", "bones: [pelvis, femr_r]",
+                  "line 38, column 60: structures[0].bones[1]: unknown bone 'femr_r'; did you "
+                  "mean 'femur_r'?"},
         Malformed{"MalformedYaml", "    tags: [bone]\n", "    tags: [bone\n",
                   "line 6, column 11: top level: malformed YAML: end of sequence flow not found"},
         Malformed{"TwoDocuments", "fixed: true}\n", "fixed: true}\n---\nname: other\n",

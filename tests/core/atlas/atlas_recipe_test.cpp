@@ -129,6 +129,14 @@ TEST(AtlasRecipeTest, DefaultRecipeReads) {
   EXPECT_EQ(condyles.axis_of_joint, "knee_r");
   EXPECT_EQ(condyles.side, "posterior");
   EXPECT_EQ(condyles.replaces.size(), condyles.lines.size());
+  // Her cartilages (hip, knee, patella, ankle) and four knee ligaments.
+  ASSERT_EQ(recipe.structures.size(), 12U);
+  EXPECT_EQ(std::ranges::count(recipe.structures, StructureKind::kLigament, &RecipeStructure::kind),
+            4);
+  for (const RecipeStructure& structure : recipe.structures) {
+    EXPECT_EQ(structure.bones.size(), structure.kind == StructureKind::kLigament ? 2U : 1U)
+        << structure.name;
+  }
 }
 
 TEST(AtlasRecipeTest, SmallRecipeReads) {
@@ -227,6 +235,33 @@ TEST(AtlasRecipeTest, AWrapSurfaceNamesItsBoneShapeCentreAndKnownLines) {
   EXPECT_THAT(with("lines: [glut_max1_r]", "lines: []"), HasSubstr("names at least one line"));
   EXPECT_THAT(with("replaces", "offset_mm: 80, replaces"),
               HasSubstr("wrap_surfaces[0].offset_mm: is 80, outside [0, 50]"));
+}
+
+TEST(AtlasRecipeTest, AStructureNamesItsKindFileAndBones) {
+  const std::string structure =
+      "structures:\n  - {name: acl, kind: ligament, file: acl.stl, bones: [femur_r, tibia_r],\n"
+      "     region: pelvis, tags: [ligament]}\n";
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string text = std::string(kRecipe) + structure;
+    if (!from.empty()) text.replace(text.find(from, std::string(kRecipe).size()), from.size(), to);
+    return rejection(text);
+  };
+  EXPECT_EQ(with("", ""), "");
+  EXPECT_THAT(with("kind: ligament", "kind: tendon"),
+              HasSubstr("structures[0].kind: unknown kind 'tendon' (expected cartilage or "
+                        "ligament)"));
+  EXPECT_THAT(with("bones: [femur_r, tibia_r]", "bones: [femur_r]"),
+              HasSubstr("a ligament names the two different bones it joins: [from, to]"));
+  EXPECT_THAT(with("bones: [femur_r, tibia_r]", "bones: [femur_r, femur_r]"),
+              HasSubstr("two different bones"));
+  EXPECT_THAT(with("kind: ligament", "kind: cartilage"),
+              HasSubstr("a cartilage names the one bone it covers: [bone]"));
+  EXPECT_THAT(with("bones: [femur_r, tibia_r]", "bones: [femur_r, tibia]"),
+              HasSubstr("structures[0].bones: unknown bone 'tibia'"));
+  EXPECT_THAT(with("name: acl", "name: femur_r"),
+              HasSubstr("'femur_r' is already the name of a bone or muscle"));
+  EXPECT_THAT(with("file: acl.stl, ", ""), HasSubstr("structures[0].file: is required"));
+  EXPECT_THAT(with("region: pelvis", "region: knee"), HasSubstr("unknown region 'knee'"));
 }
 
 TEST(AtlasRecipeTest, DuplicateNamesAreRejected) {
