@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "core/atlas/atlas_io.h"
+#include "core/atlas/structure_carriage.h"
 #include "core/directory_bundle.h"
 #include "core/errors.h"
 #include "core/mesh/io/mesh_io.h"
@@ -104,7 +105,8 @@ nlohmann::json fit_summary(const motion::FusedMotion& fused) {
           {"notes", fused.notes}};
 }
 
-// The bundle of the animation: bones of the atlas at `level`, the stick
+// The bundle of the animation: bones, cartilages and ligaments of the atlas
+// at `level`, the stick
 // figure, the action lines, per frame.
 std::string animation_bundle(const workflow::NodeContext& context, const motion::Skeleton& skeleton,
                              const motion::FusedMotion& fused,
@@ -114,6 +116,8 @@ std::string animation_bundle(const workflow::NodeContext& context, const motion:
   std::filesystem::remove_all(folder);
   mesh::VtpSeriesWriter series(folder, "motion");
   std::vector<std::pair<int, mesh::IndexedMesh>> bones;
+  std::vector<atlas::CarriedStructure> structures;
+  if (atlas != nullptr) structures = atlas::carried_structures(*atlas, atlas_dir, level);
   if (atlas != nullptr) {
     for (const atlas::Bone& bone : atlas->bones) {
       const atlas::MeshLevel* chosen = &bone.meshes.front();
@@ -135,6 +139,18 @@ std::string animation_bundle(const workflow::NodeContext& context, const motion:
         moved.V.row(v) = (pose * Eigen::Vector3d(moved.V.row(v).transpose())).transpose();
       }
       series.add_surface(t, frame, skeleton.bodies[static_cast<std::size_t>(body)].name, moved);
+    }
+    for (const atlas::CarriedStructure& structure : structures) {
+      std::vector<Eigen::Isometry3d> carriers;
+      for (const std::string& bone : structure.bones) {
+        const auto body = skeleton.body_index(bone);
+        if (!body) break;  // a bone the skeleton does not move: not drawn
+        carriers.push_back(poses[static_cast<std::size_t>(*body)]);
+      }
+      if (carriers.size() != structure.bones.size()) continue;
+      mesh::IndexedMesh moved = structure.rest;
+      moved.V = atlas::carried(structure.rest.V, structure.weights, carriers);
+      series.add_surface(t, frame, structure.name, moved);
     }
     const motion::StickFigure stick = motion::stick_figure(skeleton, poses);
     if (!stick.segments.empty()) {

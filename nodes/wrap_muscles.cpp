@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/atlas/atlas_io.h"
+#include "core/atlas/structure_carriage.h"
 #include "core/bounded_json.h"
 #include "core/directory_bundle.h"
 #include "core/errors.h"
@@ -202,6 +203,8 @@ std::string animation_bundle(const workflow::NodeContext& context,
     }
     bones.push_back(mesh::read_mesh(atlas_dir / chosen->file));
   }
+  const std::vector<atlas::CarriedStructure> structures =
+      atlas::carried_structures(atlas, atlas_dir, bone_level);
   for (Eigen::Index k = 0; k < wrapped.times.size(); k += stride) {
     const double t = wrapped.times(k);
     const auto frame = static_cast<int>(k / stride);
@@ -213,6 +216,19 @@ std::string animation_bundle(const workflow::NodeContext& context,
         moved.V.row(v) = (pose * Eigen::Vector3d(moved.V.row(v).transpose())).transpose();
       }
       series.add_surface(t, frame, wrapped.bone_names[b], moved);
+    }
+    for (const atlas::CarriedStructure& structure : structures) {
+      std::vector<Eigen::Isometry3d> carriers;
+      for (const std::string& bone : structure.bones) {
+        const auto at = std::ranges::find(wrapped.bone_names, bone);
+        if (at == wrapped.bone_names.end()) break;  // a bone that does not move: not drawn
+        carriers.push_back(
+            wrapped.bone_poses[f][static_cast<std::size_t>(at - wrapped.bone_names.begin())]);
+      }
+      if (carriers.size() != structure.bones.size()) continue;
+      mesh::IndexedMesh moved = structure.rest;
+      moved.V = atlas::carried(structure.rest.V, structure.weights, carriers);
+      series.add_surface(t, frame, structure.name, moved);
     }
     mesh::Polylines lines;
     std::vector<Eigen::Vector3d> points;

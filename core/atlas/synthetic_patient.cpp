@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/atlas/atlas_io.h"
+#include "core/atlas/structure_carriage.h"
 #include "core/errors.h"
 #include "core/image/mesh_render.h"
 #include "core/image/png.h"
@@ -20,8 +21,8 @@
 namespace mmm::atlas {
 namespace {
 
-// Writes every level of every element, deformed, under `dir`; returns the
-// full-resolution patient meshes (bones, muscles) by name.
+// Writes every level of every element (bones, structures, muscles), deformed, under `dir`; returns
+// the full-resolution patient meshes (bones, muscles) by name.
 struct PatientMeshes {
   std::map<std::string, mesh::IndexedMesh> bones;    // full
   std::map<std::string, mesh::IndexedMesh> muscles;  // `muscle_level`
@@ -44,6 +45,32 @@ PatientMeshes write_patient_meshes(const Atlas& atlas, const std::filesystem::pa
       if (level.level == "full") meshes.bones[bone.name] = deformed;
     }
     blend_bones[bone.name] = load_mesh(atlas_dir, bone.meshes, bone.meshes.back().level);
+  }
+  // Cartilages and ligaments: carried by their bones' maps (structure_carriage.h).
+  std::map<std::string, std::unique_ptr<mesh::SignedDistance>> rest_bones;
+  for (const Structure& structure : atlas.structures) {
+    std::vector<const mesh::SignedDistance*> bones;
+    for (const std::string& bone : structure.bones) {
+      if (!rest_bones.contains(bone)) {
+        rest_bones[bone] = std::make_unique<mesh::SignedDistance>(blend_bones.at(bone));
+      }
+      bones.push_back(rest_bones.at(bone).get());
+    }
+    for (const MeshLevel& level : structure.meshes) {
+      mesh::IndexedMesh deformed = load_mesh(atlas_dir, structure.meshes, level.level);
+      const Eigen::MatrixX3d rest = deformed.V;
+      const Eigen::MatrixXd weights = carriage_weights(structure, rest, bones);
+      deformed.V.setZero();
+      for (Eigen::Index i = 0; i < rest.rows(); ++i) {
+        for (std::size_t b = 0; b < structure.bones.size(); ++b) {
+          deformed.V.row(i) +=
+              weights(i, static_cast<Eigen::Index>(b)) *
+              deformation.map_on_bone(structure.bones[b], rest.row(i).transpose()).transpose();
+        }
+      }
+      std::filesystem::create_directories((dir / level.file).parent_path());
+      mesh::write_mesh(deformed, dir / level.file);
+    }
   }
   for (const Muscle& muscle : atlas.muscles) {
     for (const MeshLevel& level : muscle.meshes) {

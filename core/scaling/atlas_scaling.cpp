@@ -5,6 +5,7 @@
 
 #include "core/atlas/bone_registration.h"
 #include "core/atlas/kinematic_chain.h"
+#include "core/atlas/structure_carriage.h"
 #include "core/errors.h"
 #include "core/mesh/mass_properties.h"
 #include "core/parallel_for.h"
@@ -72,6 +73,7 @@ std::shared_ptr<const PreparedAtlas> prepare_atlas(atlas::Atlas atlas, atlas::At
     elements.push_back(bone.name);
   }
   for (const atlas::Muscle& muscle : a.muscles) elements.push_back(muscle.name);
+  for (const atlas::Structure& structure : a.structures) elements.push_back(structure.name);
   for (const std::string& element : elements) {
     mesh::validate_indices_and_coordinates(full_mesh(prepared->meshes, element));
     prepared->anchors[element] = nullptr;
@@ -95,6 +97,23 @@ std::shared_ptr<const PreparedAtlas> prepare_atlas(atlas::Atlas atlas, atlas::At
         anchors.push_back(prepared->anchors.at(element)->anchor(surface.V.row(i).transpose()));
       }
     }
+  });
+  // Cartilages and ligaments: anchored on their bones.
+  for (const atlas::Structure& structure : a.structures) prepared->structures[structure.name];
+  parallel_for(a.structures.size(), options.threads, [&](std::size_t s) {
+    const atlas::Structure& structure = a.structures[s];
+    const Eigen::MatrixX3d& rest = full_mesh(prepared->meshes, structure.name).V;
+    PreparedStructure& target = prepared->structures.at(structure.name);
+    std::vector<const mesh::SignedDistance*> bones;
+    for (const std::string& bone : structure.bones) {
+      bones.push_back(prepared->rest_distance.at(bone).get());
+      std::vector<AffineAnchor>& anchors = target.on_bones.emplace_back();
+      anchors.reserve(static_cast<std::size_t>(rest.rows()));
+      for (Eigen::Index i = 0; i < rest.rows(); ++i) {
+        anchors.push_back(prepared->anchors.at(bone)->anchor(rest.row(i).transpose()));
+      }
+    }
+    target.weights = atlas::carriage_weights(structure, rest, bones);
   });
   prepared->anchors_seconds = seconds_since(start);
   std::vector<BoneAtRest> bones;
@@ -289,6 +308,27 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
                             ? placed.vertices.at(bone.name)
                             : reconstruct_all(prepared.level_anchors.at(bone.name).at(level),
                                               placed.vertices.at(bone.name));
+    }
+  }
+  for (const atlas::Structure& structure : a.structures) {
+    const PreparedStructure& carriage = prepared.structures.at(structure.name);
+    const mesh::IndexedMesh& rest = full_mesh(prepared.meshes, structure.name);
+    Eigen::MatrixX3d full = Eigen::MatrixX3d::Zero(rest.V.rows(), 3);
+    for (std::size_t b = 0; b < structure.bones.size(); ++b) {
+      const Eigen::MatrixX3d& bone = placed.vertices.at(structure.bones[b]);
+      for (Eigen::Index i = 0; i < rest.V.rows(); ++i) {
+        full.row(i) +=
+            carriage.weights(i, static_cast<Eigen::Index>(b)) *
+            reconstruct(carriage.on_bones[b][static_cast<std::size_t>(i)], bone).transpose();
+      }
+    }
+    std::map<std::string, mesh::IndexedMesh>& levels = scaled.meshes[structure.name];
+    for (const auto& [level, surface] : prepared.meshes.at(structure.name)) {
+      levels[level].F = surface.F;
+      levels[level].V =
+          level == "full"
+              ? full
+              : reconstruct_all(prepared.level_anchors.at(structure.name).at(level), full);
     }
   }
   scaled.timings.bones_s = seconds_since(stage);

@@ -25,7 +25,9 @@
 // reconstructed from it (affine_anchor.h): landmarks, markers, joint
 // centres, bone frames, action-line points, attachment centroids and
 // wrap-obstacle centres on their bone's full surface; the coarser levels of
-// detail on their element's full surface. Orientations (frames, obstacles)
+// detail on their element's full surface. Cartilages and ligaments follow
+// their bones the same way (a ligament's vertices blend the anchors on its
+// two bones, structure_carriage.h). Orientations (frames, obstacles)
 // turn with the nearest rotation of their bone's affine part, obstacle radii
 // and the coupled translations of joints and moving path points scale with
 // its cube-root determinant, attachment areas are re-measured on the scaled
@@ -62,6 +64,13 @@ struct AtlasScalingOptions {
   int threads = 2;
 };
 
+// A cartilage or ligament: each full-level vertex anchored on each of its
+// bones' full surfaces, and its weights (structure_carriage.h).
+struct PreparedStructure {
+  std::vector<std::vector<AffineAnchor>> on_bones;  // [bone][vertex]
+  Eigen::MatrixXd weights;                          // vertices x bones
+};
+
 // Everything patient-independent, built by prepare_atlas.
 struct PreparedAtlas {
   atlas::Atlas atlas;
@@ -71,7 +80,8 @@ struct PreparedAtlas {
   std::map<std::string, std::unique_ptr<mesh::SignedDistance>> rest_distance;  // bone -> full
   // element -> level -> one anchor per vertex of that level (on the full mesh).
   std::map<std::string, std::map<std::string, std::vector<AffineAnchor>>> level_anchors;
-  std::vector<PreparedMuscle> muscles;  // atlas order
+  std::vector<PreparedMuscle> muscles;                  // atlas order
+  std::map<std::string, PreparedStructure> structures;  // by name
   double prepare_seconds = 0.0;
   double anchors_seconds = 0.0;  // of which: anchors and rest distances
 };

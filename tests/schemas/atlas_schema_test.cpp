@@ -122,7 +122,9 @@ atlas::Atlas every_kind_of_element() {
   a.landmarks = {{"femoral_head_centre_r", "femur_r", {1, 2, 3}, {"right"}, "head centre"},
                  {"patella_centre_r", "tibia_r", {4, 5, 6}, {}, ""}};
   a.markers = {{"R.ASIS", "pelvis", {7, 8, 9}, true}, {"R.Knee", "femur_r", {1, 1, 1}, false}};
-  a.regions = {{"right_thigh", {"right"}, {"femur_r"}, {"vastus_r"}}};
+  a.structures = {
+      {"acl_r", mmm::atlas::StructureKind::kLigament, {"ligament"}, {}, {"femur_r", "tibia_r"}}};
+  a.regions = {{"right_thigh", {"right"}, {"femur_r"}, {"vastus_r"}, {"acl_r"}}};
   return a;
 }
 

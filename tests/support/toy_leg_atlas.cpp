@@ -123,6 +123,26 @@ ToyLeg toy_leg() {
   for (atlas::MeshLevel& level : a.muscles[0].meshes) {
     level.faces = static_cast<int>(leg.meshes.at(a.muscles[0].name).at(level.level).F.rows());
   }
+  // A cartilage on the distal femur and a ligament from the femur to the tibia.
+  const auto add_structure = [&](const std::string& name, atlas::StructureKind kind,
+                                 std::vector<std::string> bones, const Vector3d& centre,
+                                 const Vector3d& radii) {
+    atlas::Structure structure;
+    structure.name = name;
+    structure.kind = kind;
+    structure.bones = std::move(bones);
+    leg.meshes[name]["full"] = ellipsoid(centre, radii, 3);
+    leg.meshes[name]["lod1"] = ellipsoid(centre, radii, 2);
+    for (const char* level : {"full", "lod1"}) {
+      structure.meshes.push_back({level, "meshes/" + name + "/" + level + ".ply",
+                                  static_cast<int>(leg.meshes[name][level].F.rows())});
+    }
+    a.structures.push_back(structure);
+  };
+  add_structure("femur_cartilage_r", atlas::StructureKind::kCartilage, {"femur_r"},
+                Vector3d(82.5, 5, -452), Vector3d(14, 14, 5));
+  add_structure("knee_ligament_r", atlas::StructureKind::kLigament, {"femur_r", "tibia_r"},
+                Vector3d(87, 5, -450), Vector3d(3, 3, 25));
   return leg;
 }
 

@@ -6,7 +6,8 @@
 // and both ASIS,
 // a thigh marker, and a muscle along the femur (2 mm into it, as atlas
 // segmentations overlap) with an action line, an attachment area and a wrap
-// obstacle.
+// obstacle; a cartilage on the distal femur and a ligament across the knee
+// from the femur to the tibia.
 
 #include <Eigen/Core>
 #include <filesystem>
