@@ -5,12 +5,14 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 
 #include "core/atlas/action_line_fit.h"
 #include "core/atlas/atlas_io.h"
 #include "core/atlas/attachment_areas.h"
 #include "core/atlas/bone_registration.h"
+#include "core/atlas/kinematic_chain.h"
 #include "core/atlas/muscle_cleanup.h"
 #include "core/atlas/opensim_mapping.h"
 #include "core/atlas/structure_build.h"
@@ -102,6 +104,9 @@ Eigen::Vector3d sphere_centre(const std::filesystem::path& file) {
   const mesh::IndexedMesh surface = mesh::read_mesh(file);
   return fit::sphere_fit(surface.V).center;
 }
+
+// A marker_on_bone landmark farther than this from its marker is reported.
+constexpr double kFarFromMarkerMm = 100.0;
 
 // Everything the build needs at hand.
 class Builder {
@@ -597,8 +602,16 @@ void Builder::place_landmarks() {
         throw InvalidInputError("recipe: " + field + ": no marker '" + recipe_landmark.marker +
                                 "' on an atlas bone");
       }
-      const mesh::AabbTree tree(bone_meshes_.at(recipe_landmark.bone));
-      landmark.position = tree.closest_point(it->second).point;
+      const BonePoint on_bone =
+          closest_on_segment(atlas_, bone_meshes_, recipe_landmark.bone, it->second);
+      landmark.bone = on_bone.bone;
+      landmark.position = on_bone.position;
+      if (on_bone.distance_mm > kFarFromMarkerMm) {
+        report_.notes.push_back("landmark " + landmark.name + " lies " +
+                                std::to_string(on_bone.distance_mm) + " mm from marker " +
+                                recipe_landmark.marker + ", farther than skin sits from bone: " +
+                                "is bone " + recipe_landmark.bone + " the one under the marker?");
+      }
     }
     atlas_.landmarks.push_back(std::move(landmark));
   }
@@ -794,6 +807,27 @@ AtlasBuildReport Builder::run(const std::filesystem::path& out_dir) {
 }
 
 }  // namespace
+
+BonePoint closest_on_segment(const Atlas& atlas,
+                             const std::map<std::string, mesh::IndexedMesh>& surfaces,
+                             std::string_view bone, const Eigen::Vector3d& point) {
+  std::optional<BonePoint> nearest;
+  for (const std::string& candidate : welded_together(atlas, bone)) {
+    const auto surface = surfaces.find(candidate);
+    if (surface == surfaces.end() || surface->second.F.rows() == 0) continue;
+    const mesh::AabbTree tree(surface->second);
+    const Eigen::Vector3d on_surface = tree.closest_point(point).point;
+    const double distance = (on_surface - point).norm();
+    if (!nearest || distance < nearest->distance_mm) {
+      nearest = BonePoint{candidate, on_surface, distance};
+    }
+  }
+  if (!nearest) {
+    throw InvalidInputError("no surface for bone '" + std::string(bone) +
+                            "' or the bones welded to it");
+  }
+  return *nearest;
+}
 
 AtlasBuildReport build_atlas(const AtlasRecipe& recipe, const AtlasBuildOptions& options,
                              const std::filesystem::path& out_dir) {

@@ -26,14 +26,18 @@
 //
 // Deterministic: the same recipe and data give byte-identical files.
 
+#include <Eigen/Core>
 #include <filesystem>
+#include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/atlas/atlas.h"
 #include "core/atlas/atlas_recipe.h"
 #include "core/atlas/structure_build.h"
 #include "core/atlas/wrap_surface_fit.h"
+#include "core/mesh/mesh.h"
 
 namespace mmm::atlas {
 
@@ -87,6 +91,25 @@ struct AtlasBuildReport {
   std::vector<std::string> notes;  // what was skipped or approximated, one sentence each
   double seconds = 0.0;
 };
+
+// A point on a bone's surface, the bone it lies on and how far it is from
+// the point it was found for.
+struct BonePoint {
+  std::string bone;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // atlas (mm)
+  double distance_mm = 0.0;
+};
+
+// The surface point nearest to `point` on `bone` or on any bone welded to it
+// (kinematic_chain.h: welded_together): a landmark of the pelvis is looked for
+// on the whole pelvis, whose hip bones, sacrum and coccyx are separate bones.
+// How a marker_on_bone landmark is placed; the landmark then names the bone
+// it lies on. `surfaces` holds each bone's surface (atlas frame, mm); bones
+// without one are skipped. Throws InvalidInputError when none of the
+// segment's bones has a surface.
+BonePoint closest_on_segment(const Atlas& atlas,
+                             const std::map<std::string, mesh::IndexedMesh>& surfaces,
+                             std::string_view bone, const Eigen::Vector3d& point);
 
 // Builds the atlas of `recipe` into `out_dir` (created; an existing atlas
 // there is replaced only once the new one is complete). Throws IoError for a

@@ -55,6 +55,18 @@ std::string moving_with(const Atlas& atlas, std::string bone) {
   return bone;
 }
 
+std::vector<std::string> welded_together(const Atlas& atlas, std::string_view bone) {
+  const std::string segment = moving_with(atlas, std::string(bone));
+  std::vector<std::string> bones;
+  for (const Bone& other : atlas.bones) {
+    if (other.name == bone || moving_with(atlas, other.name) == segment) {
+      bones.push_back(other.name);
+    }
+  }
+  if (bones.empty()) bones.emplace_back(bone);  // not an atlas bone: itself
+  return bones;
+}
+
 std::optional<Eigen::Vector3d> distal_joint_centre(const Atlas& atlas, std::string_view bone) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int count = 0;

@@ -95,6 +95,17 @@ void AtlasCliTest::check_passes() {
                            "lateral_epicondyle_r", "medial_malleolus_r"}) {
     EXPECT_NE(atlas.find_landmark(name), nullptr) << name;
   }
+  // Each ASIS on its own hip bone (the pelvis is four welded bones): a left
+  // ASIS looked for on the right hip bone alone lands on the pubis, 216 mm
+  // from its marker, and tips a pelvis scaled onto a subject's ASIS.
+  const atlas::Landmark* asis_r = atlas.find_landmark("asis_r");
+  const atlas::Landmark* asis_l = atlas.find_landmark("asis_l");
+  ASSERT_NE(asis_r, nullptr);
+  ASSERT_NE(asis_l, nullptr);
+  const Eigen::Vector3d across = asis_r->position - asis_l->position;
+  EXPECT_GT(across.norm(), 160.0);
+  EXPECT_LT(across.norm(), 340.0);
+  EXPECT_GT(across.x(), 0.95 * across.norm());  // x toward the subject's right
   // The femoral-head centre is the sphere fitted to the VHF head cartilage,
   // which the data's README puts at about (636.9, 448.9, 883.0) mm.
   const Eigen::Vector3d head = atlas.find_landmark("femoral_head_centre_r")->position;
