@@ -90,7 +90,9 @@ std::optional<Eigen::Vector3d> contact_point(const std::vector<Eigen::Vector3d>&
   const double search_sq = options.search_radius_mm * options.search_radius_mm;
   for (const Eigen::Vector3d& v : bundle) {
     if ((v - end).squaredNorm() > search_sq) continue;
-    const double distance = bone.closest_point(v).squared_distance;
+    const auto closest = bone.closest_point(v);
+    if (options.articular && options.articular(closest.point)) continue;
+    const double distance = closest.squared_distance;
     if (distance < nearest) {
       nearest = distance;
       nearest_vertex = v;
@@ -99,9 +101,14 @@ std::optional<Eigen::Vector3d> contact_point(const std::vector<Eigen::Vector3d>&
     sum += v;
     ++count;
   }
-  if (count >= 3) return bone.closest_point(sum / count).point;
-  if (std::isfinite(nearest)) return bone.closest_point(nearest_vertex).point;
-  return std::nullopt;
+  std::optional<Eigen::Vector3d> contact;
+  if (count >= 3) {
+    contact = bone.closest_point(sum / count).point;
+  } else if (std::isfinite(nearest)) {
+    contact = bone.closest_point(nearest_vertex).point;
+  }
+  if (contact && (*contact - end).norm() > options.max_end_shift_mm) return std::nullopt;
+  return contact;
 }
 
 Eigen::Vector3d direction_at(const std::vector<Eigen::Vector3d>& line, std::size_t i) {

@@ -8,7 +8,9 @@
 //   1. the muscle's vertices are shared among its lines (each vertex goes
 //      to the nearest line): one bundle per line;
 //   2. each end (origin, insertion) moves onto the bone where its bundle
-//      touches it: the bone point nearest the centroid of the bundle
+//      touches it (away from the articular surfaces `articular` names: a
+//      gluteus minimus lies on the hip capsule over the femoral head but
+//      inserts on the greater trochanter): the bone point nearest the centroid of the bundle
 //      vertices within `contact_mm` of the bone and `search_radius_mm` of
 //      the end, or, when the bundle does not touch the bone there, nearest
 //      the bundle's closest approach to it (a tendon the surface leaves out);
@@ -40,6 +42,10 @@ namespace mmm::atlas {
 struct ActionLineFitOptions {
   double contact_mm = 3.0;
   double search_radius_mm = 60.0;
+  // An end whose contact lies farther than this from it stays where the
+  // model puts it (the segmented belly ends short of a long tendon: its
+  // contact with the bone is not the attachment).
+  double max_end_shift_mm = 15.0;
   double slab_mm = 3.0;
   double section_radius_mm = 60.0;  // cross-section vertices farther than this are ignored
   int max_splits = 4;
@@ -51,6 +57,10 @@ struct ActionLineFitOptions {
   // Empty: a split point attaches to one of its segment's two bones.
   std::map<std::string, std::string> parent_bone;
   std::map<std::string, Eigen::Vector3d> joint_centre;
+  // True for a bone point under articular cartilage: no muscle attaches
+  // there, so bundle vertices touching the bone at such points are not
+  // contacts (empty: every bone point may be one).
+  std::function<bool(const Eigen::Vector3d&)> articular;
 };
 
 struct ActionLineFitReport {

@@ -635,6 +635,22 @@ void Builder::clean_and_attach() {
     distances[name] = std::make_unique<mesh::SignedDistance>(surface);
     trees[name] = &distances[name]->tree();
   }
+  // Bone points under the cartilages the recipe keeps clear take no muscle ends.
+  std::vector<std::pair<std::unique_ptr<mesh::SignedDistance>, double>> cartilages;
+  for (const RecipeStructure& structure : recipe_.structures) {
+    if (structure.muscle_ends_clear_mm > 0) {
+      cartilages.emplace_back(
+          std::make_unique<mesh::SignedDistance>(structure_meshes_.at(structure.name)),
+          structure.muscle_ends_clear_mm);
+    }
+  }
+  if (!cartilages.empty()) {
+    fit_options.articular = [&cartilages](const Eigen::Vector3d& p) {
+      return std::ranges::any_of(cartilages, [&](const auto& cartilage) {
+        return cartilage.first->at(p) < cartilage.second;
+      });
+    };
+  }
   MuscleCleanupOptions cleanup;
   cleanup.tolerance_mm = recipe_.penetration_tolerance_mm;
   AttachmentOptions attachment;
@@ -763,8 +779,6 @@ AtlasBuildReport Builder::run(const std::filesystem::path& out_dir) {
   build_muscles();
   map_markers();
   place_landmarks();
-  clean_and_attach();
-  report_.wrap_surfaces = add_wrap_surfaces(recipe_, bone_meshes_, atlas_);
   for (const RecipeRegion& recipe_region : recipe_.regions) {
     Region region{recipe_region.name, recipe_region.tags, {}, {}, {}};
     for (const RecipeBone& bone : recipe_.bones) {
@@ -781,6 +795,8 @@ AtlasBuildReport Builder::run(const std::filesystem::path& out_dir) {
         return mesh::read_mesh(data_file(options_, file, field));
       },
       bone_meshes_, {}, atlas_, structure_meshes_);
+  clean_and_attach();
+  report_.wrap_surfaces = add_wrap_surfaces(recipe_, bone_meshes_, atlas_);
 
   // Written beside the target, then swapped in: a failed build never leaves
   // half an atlas where a complete one was.

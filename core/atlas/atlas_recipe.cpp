@@ -425,7 +425,8 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
 
   index = 0;
   for (const YAML::Node& item :
-       reader.items(root, "structures", {"name", "kind", "file", "bones", "region", "tags"})) {
+       reader.items(root, "structures",
+                    {"name", "kind", "file", "bones", "region", "tags", "muscle_ends_clear_mm"})) {
     const std::string field = "structures[" + std::to_string(index++) + "]";
     RecipeStructure structure;
     structure.name = reader.text(item, "name", field, true);
@@ -459,6 +460,12 @@ AtlasRecipe read_atlas_recipe(const std::filesystem::path& file) {
     }
     structure.region = reader.text(item, "region", field);
     structure.tags = reader.texts(item, "tags", field);
+    structure.muscle_ends_clear_mm =
+        reader.number(item, "muscle_ends_clear_mm", field, 0.0, 0.0, 20.0);
+    if (structure.muscle_ends_clear_mm > 0 && structure.kind != StructureKind::kCartilage) {
+      reader.fail(item["muscle_ends_clear_mm"], field + ".muscle_ends_clear_mm",
+                  "is for cartilages only");
+    }
     check_region(item, field, structure.region);
     recipe.structures.push_back(std::move(structure));
   }

@@ -106,6 +106,10 @@ struct RecipeStructure {
   std::vector<std::string> bones;
   std::string region;
   std::vector<std::string> tags;
+  // A cartilage whose bone muscles lie over but do not attach to (the
+  // femoral head under the hip capsule): bone points within this distance
+  // of it take no muscle ends in the action-line fit (0: no such rule).
+  double muscle_ends_clear_mm = 0.0;
 };
 
 // Named landmarks: how each is found.
@@ -114,8 +118,8 @@ struct RecipeLandmark {
   std::string bone;
   // "sphere_centre" (of a cartilage surface `file`), "centroid" (of the
   // bone's volume), "joint_centre" (of OpenSim joint `joint`, mapped),
-  // "marker_on_bone" (the bone-surface point closest to the mapped marker
-  // `marker`).
+  // "marker_on_bone" (the point closest to the mapped marker `marker` on
+  // the bone or a bone welded to it, which the landmark then names).
   std::string method;
   std::string file;
   std::string joint;

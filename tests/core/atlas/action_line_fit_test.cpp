@@ -154,9 +154,9 @@ TEST(ActionLineFitTest, LineBesideAStraightMuscleMovesInsideAndOntoTheContacts) 
   muscle.name = "tube";
   ActionLine line;
   line.name = "tube_line";
-  // 18 mm off the axis: entirely outside the 10 mm tube.
-  line.points = {point("origin", "top", {18, 0, 103}), point("via", "bottom", {18, 0, 50}),
-                 point("insertion", "bottom", {18, 0, -3})};
+  // 12 mm off the axis: entirely outside the 10 mm tube.
+  line.points = {point("origin", "top", {12, 0, 103}), point("via", "bottom", {12, 0, 50}),
+                 point("insertion", "bottom", {12, 0, -3})};
   muscle.action_lines = {line};
 
   const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones);
@@ -186,6 +186,51 @@ TEST(ActionLineFitTest, LineBesideAStraightMuscleMovesInsideAndOntoTheContacts) 
   // The axis lies inside, so no segment needed a split.
   EXPECT_EQ(report.points_added, 0);
   EXPECT_EQ(fitted.points.size(), 3U);
+}
+
+TEST(ActionLineFitTest, AnEndFarFromTheContactStaysWhereTheModelPutsIt) {
+  // The belly ends short of a long tendon: its contact with the bone, 40 mm
+  // from the model's origin, is not where the tendon attaches.
+  const auto scene = straight_scene();
+  Muscle muscle;
+  muscle.name = "tube";
+  ActionLine line;
+  line.name = "tube_line";
+  line.points = {point("origin", "top", {40, 0, 100}), point("insertion", "bottom", {5, 0, -3})};
+  muscle.action_lines = {line};
+  const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones);
+  EXPECT_FALSE(reports.front().origin_on_contact);
+  EXPECT_TRUE(reports.front().insertion_on_contact);
+  EXPECT_EQ(muscle.action_lines.front().points.front().position, Eigen::Vector3d(40, 0, 100));
+  // Allowed a longer shift, it moves onto the contact.
+  muscle.action_lines = {line};
+  ActionLineFitOptions far;
+  far.max_end_shift_mm = 45;
+  const auto moved = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones, far);
+  EXPECT_TRUE(moved.front().origin_on_contact);
+  EXPECT_LT(
+      (muscle.action_lines.front().points.front().position - Eigen::Vector3d(0, 0, 100)).norm(),
+      1e-6);
+}
+
+TEST(ActionLineFitTest, NoEndLandsOnAnArticularSurface) {
+  // The top bone's face is articular on its x < 0 half: the contacts there
+  // do not count, and the origin moves onto the other half.
+  const auto scene = straight_scene();
+  Muscle muscle;
+  muscle.name = "tube";
+  ActionLine line;
+  line.name = "tube_line";
+  line.points = {point("origin", "top", {0, 0, 103}), point("insertion", "bottom", {0, 0, -3})};
+  muscle.action_lines = {line};
+  ActionLineFitOptions options;
+  options.articular = [](const Eigen::Vector3d& p) { return p.z() >= 99.0 && p.x() < 0.0; };
+  const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones, options);
+  EXPECT_TRUE(reports.front().origin_on_contact);
+  const PathPoint& origin = muscle.action_lines.front().points.front();
+  EXPECT_GT(origin.position.x(), 2.0);
+  EXPECT_FALSE(options.articular(origin.position));
+  EXPECT_NEAR(muscle.action_lines.front().points.back().position.x(), 0.0, 1e-6);
 }
 
 TEST(ActionLineFitTest, ArchedMuscleGetsViaPointsAlongItsCurve) {

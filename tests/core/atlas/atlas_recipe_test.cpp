@@ -262,6 +262,11 @@ TEST(AtlasRecipeTest, AStructureNamesItsKindFileAndBones) {
               HasSubstr("'femur_r' is already the name of a bone or muscle"));
   EXPECT_THAT(with("file: acl.stl, ", ""), HasSubstr("structures[0].file: is required"));
   EXPECT_THAT(with("region: pelvis", "region: knee"), HasSubstr("unknown region 'knee'"));
+  EXPECT_THAT(with("region: pelvis", "muscle_ends_clear_mm: 3, region: pelvis"),
+              HasSubstr("structures[0].muscle_ends_clear_mm: is for cartilages only"));
+  EXPECT_THAT(with("kind: ligament, file: acl.stl, bones: [femur_r, tibia_r]",
+                   "kind: cartilage, file: acl.stl, bones: [femur_r], muscle_ends_clear_mm: 30"),
+              HasSubstr("muscle_ends_clear_mm: is 30, outside [0, 20]"));
 }
 
 TEST(AtlasRecipeTest, DuplicateNamesAreRejected) {
