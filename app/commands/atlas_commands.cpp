@@ -198,7 +198,7 @@ struct ShowArgs {
 void run_show(const ShowArgs& args) {
   const atlas::Atlas model = atlas::read_atlas(args.dir);
   std::vector<mesh::IndexedMesh> surfaces;
-  surfaces.reserve(model.bones.size() + model.muscles.size());
+  surfaces.reserve(model.bones.size() + model.muscles.size() + model.structures.size());
   std::vector<image::RenderItem> bones;
   std::vector<image::RenderItem> everything;
   const auto level_of = [&](const std::vector<atlas::MeshLevel>& levels) {
@@ -212,8 +212,17 @@ void run_show(const ShowArgs& args) {
   for (const atlas::Muscle& muscle : model.muscles) {
     surfaces.push_back(atlas::load_mesh(args.dir, muscle.meshes, level_of(muscle.meshes)));
   }
+  for (const atlas::Structure& structure : model.structures) {
+    surfaces.push_back(atlas::load_mesh(args.dir, structure.meshes, level_of(structure.meshes)));
+  }
   for (std::size_t i = 0; i < model.bones.size(); ++i) {
     bones.push_back({&surfaces[i], {235, 226, 200}});
+  }
+  // Cartilages light blue, ligaments ochre, drawn with the bones (the muscles hide most of them).
+  for (std::size_t i = 0; i < model.structures.size(); ++i) {
+    const bool cartilage = model.structures[i].kind == atlas::StructureKind::kCartilage;
+    bones.push_back({&surfaces[model.bones.size() + model.muscles.size() + i],
+                     cartilage ? image::Rgb8{150, 200, 235} : image::Rgb8{205, 160, 60}});
   }
   everything = bones;
   for (std::size_t i = 0; i < model.muscles.size(); ++i) {
@@ -239,7 +248,8 @@ void run_show(const ShowArgs& args) {
       image::render_meshes(bones, front), image::render_meshes(bones, side)};
   image::write_png(image::side_by_side(panels), args.png);
   std::cout << "wrote " << args.png << ": front and side views with muscles, then bones only ("
-            << model.bones.size() << " bones, " << model.muscles.size() << " muscles)\n";
+            << model.bones.size() << " bones, " << model.muscles.size() << " muscles, "
+            << model.structures.size() << " cartilages and ligaments)\n";
 }
 
 struct CheckArgs {
