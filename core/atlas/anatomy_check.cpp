@@ -83,14 +83,18 @@ void check_cartilages(const std::string& articulation, const std::vector<std::st
       facing = true;
       const BoneContact contact = contact_between({a, &a_surface}, {b, &b_surface});
       report.cartilage_contacts.push_back({articulation, a, b, contact.gap_mm, contact.overlap_mm});
+      std::string pair = "articulation ";
+      pair += articulation;
+      pair += ": cartilages ";
+      pair += a;
+      pair += " and ";
+      pair += b;
       if (contact.gap_mm > limits.max_cartilage_gap_mm) {
-        problems.push_back("articulation " + articulation + ": cartilages " + a + " and " + b +
-                           " are " + mm_text(contact.gap_mm) + " apart (at most " +
+        problems.push_back(pair + " are " + mm_text(contact.gap_mm) + " apart (at most " +
                            mm_text(limits.max_cartilage_gap_mm) + " allowed)");
       }
       if (contact.overlap_mm > limits.max_cartilage_overlap_mm) {
-        problems.push_back("articulation " + articulation + ": cartilages " + a + " and " + b +
-                           " overlap by " + mm_text(contact.overlap_mm) + " (at most " +
+        problems.push_back(pair + " overlap by " + mm_text(contact.overlap_mm) + " (at most " +
                            mm_text(limits.max_cartilage_overlap_mm) + " allowed)");
       }
     }

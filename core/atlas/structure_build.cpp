@@ -55,10 +55,16 @@ std::vector<StructureBuildReport> add_structures(
       report.gap_mm.emplace_back(bone, contact.gap_mm);
       report.overlap_mm.emplace_back(bone, contact.overlap_mm);
       if (contact.gap_mm > options.max_gap_mm) {
-        throw InvalidInputError("atlas build: " + what + " is " + millimetres(contact.gap_mm) +
-                                " from its bone " + bone + " (at most " +
-                                millimetres(options.max_gap_mm) +
-                                "): it would float away with it; check the file and the bone");
+        std::string message = "atlas build: ";
+        message += what;
+        message += " is ";
+        message += millimetres(contact.gap_mm);
+        message += " from its bone ";
+        message += bone;
+        message += " (at most ";
+        message += millimetres(options.max_gap_mm);
+        message += "): it would float away with it; check the file and the bone";
+        throw InvalidInputError(message);
       }
     }
     Structure structure;
