@@ -5,18 +5,11 @@
 #include <cmath>
 #include <limits>
 #include <set>
-#include <sstream>
+
+#include "core/atlas/millimetres_text.h"
 
 namespace mmm::atlas {
 namespace {
-
-std::string mm_text(double value) {
-  std::ostringstream text;
-  text.setf(std::ios::fixed);
-  text.precision(2);
-  text << value << " mm";
-  return text.str();
-}
 
 bool tagged(const Bone& bone, const std::string& tag) {
   return std::ranges::find(bone.tags, tag) != bone.tags.end();
@@ -90,19 +83,21 @@ void check_cartilages(const std::string& articulation, const std::vector<std::st
       pair += " and ";
       pair += b;
       if (contact.gap_mm > limits.max_cartilage_gap_mm) {
-        problems.push_back(pair + " are " + mm_text(contact.gap_mm) + " apart (at most " +
-                           mm_text(limits.max_cartilage_gap_mm) + " allowed)");
+        problems.push_back(pair + " are " + millimetres_text(contact.gap_mm) + " apart (at most " +
+                           millimetres_text(limits.max_cartilage_gap_mm) + " allowed)");
       }
       if (contact.overlap_mm > limits.max_cartilage_overlap_mm) {
-        problems.push_back(pair + " overlap by " + mm_text(contact.overlap_mm) + " (at most " +
-                           mm_text(limits.max_cartilage_overlap_mm) + " allowed)");
+        problems.push_back(pair + " overlap by " + millimetres_text(contact.overlap_mm) +
+                           " (at most " + millimetres_text(limits.max_cartilage_overlap_mm) +
+                           " allowed)");
       }
     }
   }
   if (!facing) {
     problems.push_back("articulation " + articulation + ": no cartilage of " + one.front() +
                        "'s side faces one of the other side within " +
-                       mm_text(limits.cartilage_reach_mm) + " (a displaced bone or cartilage?)");
+                       millimetres_text(limits.cartilage_reach_mm) +
+                       " (a displaced bone or cartilage?)");
   }
 }
 
@@ -125,8 +120,8 @@ AnatomyReport check_anatomy(const Atlas& atlas,
     if (contact.overlap_mm > limits.max_bone_overlap_mm) {
       const std::string& other = contact.entering == contact.a ? contact.b : contact.a;
       problems.push_back("bone " + contact.entering + " enters " + other + " by " +
-                         mm_text(contact.overlap_mm) + " (at most " +
-                         mm_text(limits.max_bone_overlap_mm) + " allowed)");
+                         millimetres_text(contact.overlap_mm) + " (at most " +
+                         millimetres_text(limits.max_bone_overlap_mm) + " allowed)");
     }
   }
   for (const NamedSurface& bone : surfaces) {
@@ -145,9 +140,9 @@ AnatomyReport check_anatomy(const Atlas& atlas,
     }
     report.nearest_neighbour_gap_mm[bone.name] = nearest;
     if (surfaces.size() > 1 && nearest > limits.max_neighbour_gap_mm) {
-      problems.push_back("bone " + bone.name + " is " + mm_text(nearest) +
+      problems.push_back("bone " + bone.name + " is " + millimetres_text(nearest) +
                          " from its nearest neighbour (at most " +
-                         mm_text(limits.max_neighbour_gap_mm) + " allowed)");
+                         millimetres_text(limits.max_neighbour_gap_mm) + " allowed)");
     }
   }
 
@@ -175,8 +170,8 @@ AnatomyReport check_anatomy(const Atlas& atlas,
     }
     if (best.gap_mm > limits.max_joint_gap_mm) {
       problems.push_back("articulation " + name + ": " + best.a + " and " + best.b + " are " +
-                         mm_text(best.gap_mm) + " apart (at most " +
-                         mm_text(limits.max_joint_gap_mm) + " allowed)");
+                         millimetres_text(best.gap_mm) + " apart (at most " +
+                         millimetres_text(limits.max_joint_gap_mm) + " allowed)");
     }
     report.articulations.push_back(best);
     check_cartilages(name, cartilages_on(atlas, structures, one),
@@ -219,8 +214,9 @@ AnatomyReport check_anatomy(const Atlas& atlas,
       report.structure_attachments.push_back({structure.name, bone, gap});
       if (gap > limits.max_structure_gap_mm) {
         problems.push_back(std::string(structure_kind_name(structure.kind)) + " " + structure.name +
-                           " is " + mm_text(gap) + " from its bone " + bone + " (at most " +
-                           mm_text(limits.max_structure_gap_mm) + " allowed)");
+                           " is " + millimetres_text(gap) + " from its bone " + bone +
+                           " (at most " + millimetres_text(limits.max_structure_gap_mm) +
+                           " allowed)");
       }
     }
   }
@@ -230,9 +226,9 @@ AnatomyReport check_anatomy(const Atlas& atlas,
   if (head != nullptr && socket != nullptr) {
     report.hip_centre_offset_mm = (head->position - socket->position).norm();
     if (report.hip_centre_offset_mm > limits.max_hip_centre_offset_mm) {
-      problems.push_back("the femoral head is " + mm_text(report.hip_centre_offset_mm) +
+      problems.push_back("the femoral head is " + millimetres_text(report.hip_centre_offset_mm) +
                          " from the centre of the acetabulum (at most " +
-                         mm_text(limits.max_hip_centre_offset_mm) + " allowed)");
+                         millimetres_text(limits.max_hip_centre_offset_mm) + " allowed)");
     }
   }
   return report;

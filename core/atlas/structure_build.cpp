@@ -1,24 +1,12 @@
 #include "core/atlas/structure_build.h"
 
-#include <sstream>
-
 #include "core/atlas/bone_contacts.h"
+#include "core/atlas/millimetres_text.h"
 #include "core/errors.h"
 #include "core/mesh/mass_properties.h"
 #include "core/mesh/mesh_check.h"
 
 namespace mmm::atlas {
-namespace {
-
-std::string millimetres(double value) {
-  std::ostringstream text;
-  text.setf(std::ios::fixed);
-  text.precision(2);
-  text << value << " mm";
-  return text.str();
-}
-
-}  // namespace
 
 std::vector<StructureBuildReport> add_structures(
     const AtlasRecipe& recipe,
@@ -58,11 +46,11 @@ std::vector<StructureBuildReport> add_structures(
         std::string message = "atlas build: ";
         message += what;
         message += " is ";
-        message += millimetres(contact.gap_mm);
+        message += millimetres_text(contact.gap_mm);
         message += " from its bone ";
         message += bone;
         message += " (at most ";
-        message += millimetres(options.max_gap_mm);
+        message += millimetres_text(options.max_gap_mm);
         message += "): it would float away with it; check the file and the bone";
         throw InvalidInputError(message);
       }
