@@ -140,17 +140,15 @@ std::string animation_bundle(const workflow::NodeContext& context, const motion:
       }
       series.add_surface(t, frame, skeleton.bodies[static_cast<std::size_t>(body)].name, moved);
     }
+    const auto pose_of = [&](const std::string& bone) -> std::optional<Eigen::Isometry3d> {
+      const auto body = skeleton.body_index(bone);
+      if (!body) return std::nullopt;
+      return poses[static_cast<std::size_t>(*body)];
+    };
     for (const atlas::CarriedStructure& structure : structures) {
-      std::vector<Eigen::Isometry3d> carriers;
-      for (const std::string& bone : structure.bones) {
-        const auto body = skeleton.body_index(bone);
-        if (!body) break;  // a bone the skeleton does not move: not drawn
-        carriers.push_back(poses[static_cast<std::size_t>(*body)]);
+      if (auto moved = atlas::carried_surface(structure, pose_of)) {
+        series.add_surface(t, frame, structure.name, *moved);
       }
-      if (carriers.size() != structure.bones.size()) continue;
-      mesh::IndexedMesh moved = structure.rest;
-      moved.V = atlas::carried(structure.rest.V, structure.weights, carriers);
-      series.add_surface(t, frame, structure.name, moved);
     }
     const motion::StickFigure stick = motion::stick_figure(skeleton, poses);
     if (!stick.segments.empty()) {

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -217,18 +218,15 @@ std::string animation_bundle(const workflow::NodeContext& context,
       }
       series.add_surface(t, frame, wrapped.bone_names[b], moved);
     }
+    const auto pose_of = [&](const std::string& bone) -> std::optional<Eigen::Isometry3d> {
+      const auto at = std::ranges::find(wrapped.bone_names, bone);
+      if (at == wrapped.bone_names.end()) return std::nullopt;
+      return wrapped.bone_poses[f][static_cast<std::size_t>(at - wrapped.bone_names.begin())];
+    };
     for (const atlas::CarriedStructure& structure : structures) {
-      std::vector<Eigen::Isometry3d> carriers;
-      for (const std::string& bone : structure.bones) {
-        const auto at = std::ranges::find(wrapped.bone_names, bone);
-        if (at == wrapped.bone_names.end()) break;  // a bone that does not move: not drawn
-        carriers.push_back(
-            wrapped.bone_poses[f][static_cast<std::size_t>(at - wrapped.bone_names.begin())]);
+      if (auto moved = atlas::carried_surface(structure, pose_of)) {
+        series.add_surface(t, frame, structure.name, *moved);
       }
-      if (carriers.size() != structure.bones.size()) continue;
-      mesh::IndexedMesh moved = structure.rest;
-      moved.V = atlas::carried(structure.rest.V, structure.weights, carriers);
-      series.add_surface(t, frame, structure.name, moved);
     }
     mesh::Polylines lines;
     std::vector<Eigen::Vector3d> points;

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/atlas/millimetres_text.h"
+#include "core/mesh/mass_properties.h"
 
 namespace mmm::atlas {
 namespace {
@@ -37,8 +38,7 @@ const BoneContact* find_contact(const std::vector<BoneContact>& contacts, const 
 }
 
 Eigen::AlignedBox3d box_of(const mesh::IndexedMesh& surface, double grown_by) {
-  Eigen::AlignedBox3d box;
-  for (Eigen::Index i = 0; i < surface.V.rows(); ++i) box.extend(surface.V.row(i).transpose());
+  Eigen::AlignedBox3d box = mesh::bounding_box(surface);
   box.min().array() -= grown_by;
   box.max().array() += grown_by;
   return box;
@@ -63,8 +63,8 @@ std::vector<std::string> cartilages_on(const Atlas& atlas,
 void check_cartilages(const std::string& articulation, const std::vector<std::string>& one,
                       const std::vector<std::string>& other,
                       const std::map<std::string, mesh::IndexedMesh>& structures,
-                      const AnatomyLimits& limits, AnatomyReport& report,
-                      std::vector<std::string>& problems) {
+                      SurfaceDistances& distances, const AnatomyLimits& limits,
+                      AnatomyReport& report, std::vector<std::string>& problems) {
   if (one.empty() || other.empty()) return;
   bool facing = false;
   for (const std::string& a : one) {
@@ -74,7 +74,10 @@ void check_cartilages(const std::string& articulation, const std::vector<std::st
       const mesh::IndexedMesh& b_surface = structures.at(b);
       if (!a_box.intersects(box_of(b_surface, 0.5 * limits.cartilage_reach_mm))) continue;
       facing = true;
-      const BoneContact contact = contact_between({a, &a_surface}, {b, &b_surface});
+      const NamedSurface first{a, &a_surface};
+      const NamedSurface second{b, &b_surface};
+      const BoneContact contact =
+          contact_between(first, distances.of(first), second, distances.of(second));
       report.cartilage_contacts.push_back({articulation, a, b, contact.gap_mm, contact.overlap_mm});
       std::string pair = "articulation ";
       pair += articulation;
@@ -108,6 +111,9 @@ AnatomyReport check_anatomy(const Atlas& atlas,
                             const std::map<std::string, mesh::IndexedMesh>& structures,
                             const AnatomyLimits& limits, std::vector<std::string>& problems) {
   AnatomyReport report;
+  // Each cartilage, ligament and bone they meet measured with one signed
+  // distance (the distal femur's cartilage faces both plateaus and the patella).
+  SurfaceDistances distances;
   std::vector<NamedSurface> surfaces;
   for (const Bone& bone : atlas.bones) {
     const auto it = bones.find(bone.name);
@@ -175,7 +181,8 @@ AnatomyReport check_anatomy(const Atlas& atlas,
     }
     report.articulations.push_back(best);
     check_cartilages(name, cartilages_on(atlas, structures, one),
-                     cartilages_on(atlas, structures, other), structures, limits, report, problems);
+                     cartilages_on(atlas, structures, other), structures, distances, limits, report,
+                     problems);
   };
   const auto members = [&](const std::string& side) {
     std::set<std::string> names;
@@ -209,8 +216,10 @@ AnatomyReport check_anatomy(const Atlas& atlas,
     if (surface == structures.end()) continue;
     for (const std::string& bone : structure.bones) {
       if (!bones.contains(bone)) continue;
+      const NamedSurface carried{structure.name, &surface->second};
+      const NamedSurface carrier{bone, &bones.at(bone)};
       const double gap =
-          contact_between({structure.name, &surface->second}, {bone, &bones.at(bone)}).gap_mm;
+          contact_between(carried, distances.of(carried), carrier, distances.of(carrier)).gap_mm;
       report.structure_attachments.push_back({structure.name, bone, gap});
       if (gap > limits.max_structure_gap_mm) {
         problems.push_back(std::string(structure_kind_name(structure.kind)) + " " + structure.name +

@@ -3,21 +3,15 @@
 #include <Eigen/Geometry>
 #include <memory>
 
+#include "core/mesh/mass_properties.h"
 #include "core/mesh/penetration.h"
 #include "core/mesh/signed_distance.h"
 #include "core/mesh/surface_distance.h"
 
 namespace mmm::atlas {
-namespace {
 
-Eigen::AlignedBox3d box_of(const mesh::IndexedMesh& surface) {
-  Eigen::AlignedBox3d box;
-  for (Eigen::Index i = 0; i < surface.V.rows(); ++i) box.extend(surface.V.row(i).transpose());
-  return box;
-}
-
-BoneContact measure(const NamedSurface& a, const mesh::SignedDistance& a_distance,
-                    const NamedSurface& b, const mesh::SignedDistance& b_distance) {
+BoneContact contact_between(const NamedSurface& a, const mesh::SignedDistance& a_distance,
+                            const NamedSurface& b, const mesh::SignedDistance& b_distance) {
   BoneContact contact;
   contact.a = a.name;
   contact.b = b.name;
@@ -33,19 +27,23 @@ BoneContact measure(const NamedSurface& a, const mesh::SignedDistance& a_distanc
   return contact;
 }
 
-}  // namespace
-
 BoneContact contact_between(const NamedSurface& a, const NamedSurface& b) {
   const mesh::SignedDistance a_distance(*a.surface);
   const mesh::SignedDistance b_distance(*b.surface);
-  return measure(a, a_distance, b, b_distance);
+  return contact_between(a, a_distance, b, b_distance);
+}
+
+const mesh::SignedDistance& SurfaceDistances::of(const NamedSurface& surface) {
+  std::unique_ptr<mesh::SignedDistance>& distance = built_[surface.name];
+  if (distance == nullptr) distance = std::make_unique<mesh::SignedDistance>(*surface.surface);
+  return *distance;
 }
 
 std::vector<BoneContact> bone_contacts(const std::vector<NamedSurface>& bones, double reach_mm) {
   std::vector<Eigen::AlignedBox3d> boxes;
   std::vector<std::unique_ptr<mesh::SignedDistance>> distances;
   for (const NamedSurface& bone : bones) {
-    Eigen::AlignedBox3d box = box_of(*bone.surface);
+    Eigen::AlignedBox3d box = mesh::bounding_box(*bone.surface);
     box.min().array() -= reach_mm;
     box.max().array() += reach_mm;
     boxes.push_back(box);
@@ -55,7 +53,7 @@ std::vector<BoneContact> bone_contacts(const std::vector<NamedSurface>& bones, d
   for (std::size_t i = 0; i < bones.size(); ++i) {
     for (std::size_t j = i + 1; j < bones.size(); ++j) {
       if (!boxes[i].intersects(boxes[j])) continue;
-      BoneContact contact = measure(bones[i], *distances[i], bones[j], *distances[j]);
+      BoneContact contact = contact_between(bones[i], *distances[i], bones[j], *distances[j]);
       if (contact.gap_mm <= reach_mm) contacts.push_back(std::move(contact));
     }
   }

@@ -6,10 +6,13 @@
 // neighbours, every joint's bones close (atlas_check.h).
 
 #include <Eigen/Core>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/mesh/mesh.h"
+#include "core/mesh/signed_distance.h"
 
 namespace mmm::atlas {
 
@@ -33,5 +36,20 @@ std::vector<BoneContact> bone_contacts(const std::vector<NamedSurface>& bones, d
 // The gap between two surfaces (both directions) and their overlap, whatever
 // the distance.
 BoneContact contact_between(const NamedSurface& a, const NamedSurface& b);
+
+// The same with the two surfaces' signed distances already built (a surface
+// measured against several others builds its own once).
+BoneContact contact_between(const NamedSurface& a, const mesh::SignedDistance& a_distance,
+                            const NamedSurface& b, const mesh::SignedDistance& b_distance);
+
+// Signed distances of named surfaces, each built the first time it is asked
+// for. Not thread-safe.
+class SurfaceDistances {
+ public:
+  const mesh::SignedDistance& of(const NamedSurface& surface);
+
+ private:
+  std::map<std::string, std::unique_ptr<mesh::SignedDistance>> built_;
+};
 
 }  // namespace mmm::atlas

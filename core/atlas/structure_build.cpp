@@ -14,6 +14,7 @@ std::vector<StructureBuildReport> add_structures(
     const std::map<std::string, mesh::IndexedMesh>& bones, const StructureBuildOptions& options,
     Atlas& atlas, std::map<std::string, mesh::IndexedMesh>& surfaces) {
   std::vector<StructureBuildReport> reports;
+  SurfaceDistances distances;  // a bone carrying several structures is measured once
   for (const RecipeStructure& source : recipe.structures) {
     const std::string what = std::string(structure_kind_name(source.kind)) + " " + source.name;
     mesh::IndexedMesh surface = read(source.file, "structures." + source.name + ".file");
@@ -39,7 +40,10 @@ std::vector<StructureBuildReport> add_structures(
                               " is inside out (negative volume); flip its faces");
     }
     for (const std::string& bone : source.bones) {
-      const BoneContact contact = contact_between({source.name, &surface}, {bone, &bones.at(bone)});
+      const NamedSurface carried{source.name, &surface};
+      const NamedSurface carrier{bone, &bones.at(bone)};
+      const BoneContact contact =
+          contact_between(carried, distances.of(carried), carrier, distances.of(carrier));
       report.gap_mm.emplace_back(bone, contact.gap_mm);
       report.overlap_mm.emplace_back(bone, contact.overlap_mm);
       if (contact.gap_mm > options.max_gap_mm) {

@@ -61,6 +61,20 @@ std::string level_or_finest(const std::vector<MeshLevel>& levels, const std::str
 
 }  // namespace
 
+std::optional<mesh::IndexedMesh> carried_surface(
+    const CarriedStructure& structure,
+    const std::function<std::optional<Eigen::Isometry3d>(const std::string& bone)>& pose_of) {
+  std::vector<Eigen::Isometry3d> carriers;
+  for (const std::string& bone : structure.bones) {
+    const std::optional<Eigen::Isometry3d> pose = pose_of(bone);
+    if (!pose) return std::nullopt;
+    carriers.push_back(*pose);
+  }
+  mesh::IndexedMesh moved = structure.rest;
+  moved.V = carried(structure.rest.V, structure.weights, carriers);
+  return moved;
+}
+
 std::vector<CarriedStructure> carried_structures(const Atlas& atlas,
                                                  const std::filesystem::path& dir,
                                                  const std::string& level) {

@@ -13,6 +13,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +43,13 @@ struct CarriedStructure {
   std::vector<std::string> bones;  // the columns of `weights`
   Eigen::MatrixXd weights;
 };
+
+// `structure`'s surface moved by its bones: `pose_of` gives a bone's pose
+// (rest -> moved), or nullopt for a bone that does not move; nullopt when
+// one of the structure's bones does not (it is then not drawn).
+std::optional<mesh::IndexedMesh> carried_surface(
+    const CarriedStructure& structure,
+    const std::function<std::optional<Eigen::Isometry3d>(const std::string& bone)>& pose_of);
 
 // Every structure of the atlas in `dir` at `level` (the finest level it has
 // when it lacks that one), weighed on its bones' surfaces at the same level.
