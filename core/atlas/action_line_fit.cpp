@@ -254,6 +254,7 @@ std::vector<ActionLineFitReport> fit_action_lines(
       if (line.points[i].kind == PathPointKind::kMoving) continue;
       if (const auto centre =
               section_centre(bundle, current[i], direction_at(current, i), geometry, options)) {
+        if ((*centre - current[i]).norm() > options.max_via_shift_mm) continue;
         line.points[i].position = *centre;
         current[i] = *centre;
       }

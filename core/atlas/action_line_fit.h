@@ -17,8 +17,9 @@
 //   3. each via point (fixed or conditional) moves to the centre of its
 //      bundle's cross-section in the slab of half-width `slab_mm` across the
 //      line at that point: the section's point deepest inside the muscle
-//      among its centroid and midpoints of its vertices (moving points,
-//      whose place is a function of a coordinate, stay);
+//      among its centroid and midpoints of its vertices, when that centre
+//      lies within `max_via_shift_mm` of it (moving points, whose place is
+//      a function of a coordinate, stay);
 //   4. a segment that still leaves the muscle is split at its middle by a
 //      new fixed via point at the cross-section centre there, attached to
 //      the bone of the kinematic chain between the segment's two bones that
@@ -44,8 +45,16 @@ struct ActionLineFitOptions {
   double search_radius_mm = 60.0;
   // An end whose contact lies farther than this from it stays where the
   // model puts it (the segmented belly ends short of a long tendon: its
-  // contact with the bone is not the attachment).
-  double max_end_shift_mm = 15.0;
+  // contact with the bone is not the attachment). About 1.5 times the
+  // bone registrations' surface RMS (4.4-8.2 mm on the default atlas).
+  double max_end_shift_mm = 12.0;
+  // Likewise a via point whose cross-section centre lies farther than this
+  // from it stays where the model puts it: through a thick muscle (gluteus
+  // maximus behind the trochanter, psoas at the pelvic brim) the centre of
+  // the section is not where the tendon runs over the bone. Lines drawn
+  // from the muscle's own surface have no model place to keep: use
+  // infinity for them.
+  double max_via_shift_mm = 15.0;
   double slab_mm = 3.0;
   double section_radius_mm = 60.0;  // cross-section vertices farther than this are ignored
   int max_splits = 4;

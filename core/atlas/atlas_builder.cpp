@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -678,9 +679,16 @@ void Builder::clean_and_attach() {
 
     const mesh::AabbTree muscle_tree(surface);
     const mesh::WindingNumber winding(muscle_tree);
+    // A line drawn from the muscle's own surface has no model place to keep.
+    ActionLineFitOptions muscle_fit = fit_options;
+    const auto from_recipe = std::ranges::find_if(
+        recipe_.muscles, [&](const RecipeMuscle& m) { return m.name == muscle.name; });
+    if (from_recipe != recipe_.muscles.end() && !from_recipe->surface_line.empty()) {
+      muscle_fit.max_via_shift_mm = std::numeric_limits<double>::infinity();
+    }
     for (const ActionLineFitReport& fitted : fit_action_lines(
              muscle, muscle_tree, [&](const Eigen::Vector3d& q) { return winding.is_inside(q); },
-             trees, fit_options)) {
+             trees, muscle_fit)) {
       report_.action_lines.push_back({muscle.name, fitted.line, fitted.inside_before,
                                       fitted.inside_after, fitted.points_added,
                                       fitted.origin_on_contact, fitted.insertion_on_contact});

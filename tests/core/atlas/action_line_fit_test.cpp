@@ -25,6 +25,15 @@ namespace {
 constexpr double kTubeRadius = 10.0;  // mm
 constexpr int kSegments = 32;         // vertices around a ring
 
+// Points move however far their contact or section centre lies: the fit's
+// geometry alone, without the limits that keep a model's points in place.
+ActionLineFitOptions without_shift_limits() {
+  ActionLineFitOptions options;
+  options.max_end_shift_mm = std::numeric_limits<double>::infinity();
+  options.max_via_shift_mm = std::numeric_limits<double>::infinity();
+  return options;
+}
+
 // A closed tube of radius r swept along a centre line: rings of kSegments
 // vertices around centres[k] in the plane spanned by u[k], v[k] (unit,
 // perpendicular to the line), closed by a fan around each end's centre.
@@ -159,7 +168,8 @@ TEST(ActionLineFitTest, LineBesideAStraightMuscleMovesInsideAndOntoTheContacts) 
                  point("insertion", "bottom", {12, 0, -3})};
   muscle.action_lines = {line};
 
-  const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones);
+  const auto reports =
+      fit_action_lines(muscle, scene->tree, scene->inside, scene->bones, without_shift_limits());
   ASSERT_EQ(reports.size(), 1U);
   const ActionLineFitReport& report = reports.front();
   EXPECT_EQ(report.line, "tube_line");
@@ -213,6 +223,41 @@ TEST(ActionLineFitTest, AnEndFarFromTheContactStaysWhereTheModelPutsIt) {
       1e-6);
 }
 
+TEST(ActionLineFitTest, AViaPointFarFromItsSectionCentreStaysAndTheDrawnPathBendsInside) {
+  // The model's via point runs 25 mm off the tube's axis (a tendon over the
+  // bone, beside a thick belly): beyond the 15 mm limit it keeps its place,
+  // and the points added to keep the path inside only follow the line.
+  const auto scene = straight_scene();
+  Muscle muscle;
+  muscle.name = "tube";
+  ActionLine line;
+  line.name = "tube_line";
+  line.points = {point("origin", "top", {0, 0, 103}), point("via", "bottom", {25, 0, 50}),
+                 point("insertion", "bottom", {0, 0, -3})};
+  muscle.action_lines = {line};
+  const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones);
+  const ActionLine& kept = muscle.action_lines.front();
+  const auto via =
+      std::ranges::find_if(kept.points, [](const PathPoint& p) { return p.name == "via"; });
+  ASSERT_NE(via, kept.points.end());
+  EXPECT_EQ(via->position, Eigen::Vector3d(25, 0, 50));
+  EXPECT_GT(reports.front().points_added, 0);
+  for (const PathPoint& p : kept.points) {
+    if (p.kind == PathPointKind::kFollowsLine) {
+      EXPECT_TRUE(scene->inside(p.position)) << p.name;
+    }
+  }
+  // Allowed a longer shift, it moves onto the section's centre, on the axis.
+  muscle.action_lines = {line};
+  ActionLineFitOptions far;
+  far.max_via_shift_mm = 30;
+  fit_action_lines(muscle, scene->tree, scene->inside, scene->bones, far);
+  const PathPoint& moved = muscle.action_lines.front().points[1];
+  EXPECT_EQ(moved.name, "via");
+  EXPECT_LT(moved.position.head<2>().norm(), 1e-6);
+  EXPECT_NEAR(moved.position.z(), 50.0, 2.0);
+}
+
 TEST(ActionLineFitTest, NoEndLandsOnAnArticularSurface) {
   // The top bone's face is articular on its x < 0 half: the contacts there
   // do not count, and the origin moves onto the other half.
@@ -248,7 +293,8 @@ TEST(ActionLineFitTest, ArchedMuscleGetsViaPointsAlongItsCurve) {
                  point("insertion", "left_foot", {-60, 0, -5})};
   muscle.action_lines = {line};
 
-  const auto reports = fit_action_lines(muscle, scene.tree, scene.inside, scene.bones);
+  const auto reports =
+      fit_action_lines(muscle, scene.tree, scene.inside, scene.bones, without_shift_limits());
   ASSERT_EQ(reports.size(), 1U);
   const ActionLineFitReport& report = reports.front();
   EXPECT_LT(report.inside_before, 0.2);
@@ -301,7 +347,7 @@ TEST(ActionLineFitTest, SplitPointsRideOnTheNearestBoneAlongTheChain) {
   line.points = {point("origin", "right_foot", {60, 0, -5}), point("via", "right_foot", {0, 0, 20}),
                  point("insertion", "left_foot", {-60, 0, -5})};
   muscle.action_lines = {line};
-  ActionLineFitOptions options;
+  ActionLineFitOptions options = without_shift_limits();
   options.parent_bone = {{"right_foot", "keystone"}, {"left_foot", "keystone"}};
   const auto reports = fit_action_lines(muscle, scene.tree, scene.inside, scene.bones, options);
   ASSERT_GT(reports.front().points_added, 0);
