@@ -1,11 +1,14 @@
 #include "nodes/decompose_fibres.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -21,6 +24,7 @@
 #include "core/mesh/io/pvd.h"
 #include "core/mesh/io/vtp.h"
 #include "core/mesh/io/vtp_series.h"
+#include "core/parallel_for.h"
 #include "core/wrapping/muscle_hulls.h"
 #include "core/wrapping/muscle_wrapping.h"
 #include "nodes/fibre_picture.h"
@@ -82,7 +86,9 @@ class BonePoses {
   BonePoses(const atlas::Atlas& atlas, std::filesystem::path atlas_dir)
       : atlas_(atlas), atlas_dir_(std::move(atlas_dir)) {}
 
+  // Safe to call from several threads.
   Eigen::Isometry3d pose(const std::string& bone, std::size_t index, const AnimationFrame& frame) {
+    const std::scoped_lock lock(mutex_);
     const auto known = poses_.find({bone, index});
     if (known != poses_.end()) return known->second;
     const auto part = frame.parts.find(bone);
@@ -112,6 +118,7 @@ class BonePoses {
 
   const atlas::Atlas& atlas_;
   std::filesystem::path atlas_dir_;
+  std::mutex mutex_;
   std::map<std::string, Eigen::MatrixX3d> cache_;
   std::map<std::pair<std::string, std::size_t>, Eigen::Isometry3d> poses_;
 };
@@ -132,6 +139,19 @@ mesh::Polylines as_polylines(const std::vector<fibres::Fibre>& fibres) {
   }
   return lines;
 }
+
+// One muscle's decomposition at rest and in every frame, computed on a
+// worker thread and written out in muscle order.
+struct MuscleResult {
+  DecompositionMethod method = DecompositionMethod::kSlicing;
+  fibres::MuscleFibres rest;
+  fibres::FibreQuality quality;
+  mesh::IndexedMesh rest_surface;                  // kept for the pictured muscle only
+  std::vector<std::vector<fibres::Fibre>> frames;  // per animation frame
+  double field_seconds = 0.0;
+  double frame_seconds = 0.0;
+  double frames_inside = 1.0;  // the worst frame's inside fraction, against that frame's surface
+};
 
 }  // namespace
 
@@ -166,6 +186,10 @@ workflow::NodeSpec DecomposeFibres::spec() {
                           "Comma-separated muscle names; empty: every muscle of the atlas")
       .param<std::string>("picture_muscle", "gluteus_medius_r",
                           "The muscle shown in the picture (the first one when absent)")
+      .param<std::int64_t>("threads", 0,
+                           "Worker threads (muscles in parallel; the outputs do not depend on "
+                           "it); 0: the machine's",
+                           {.min = 0, .max = 256})
       .output<File>("fibres", "Folder bundle: fibres.pvd + .vtp polylines per muscle and frame")
       .output<File>("lengths", "CSV: muscle, method, fibre, frame, time (s), length (mm)")
       .output<File>("picture", "PNG: a muscle with its fibres, front and side")
@@ -187,7 +211,9 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
   options.fibres = static_cast<int>(context.integer("fibres"));
   options.segments = static_cast<int>(context.integer("segments"));
   std::map<std::string, mesh::IndexedMesh> bones;
+  std::mutex bones_mutex;
   const auto bone_surface = [&](const std::string& name) -> const mesh::IndexedMesh& {
+    const std::scoped_lock lock(bones_mutex);
     auto found = bones.find(name);
     if (found == bones.end()) {
       const atlas::Bone* bone = atlas.find_bone(name);
@@ -213,71 +239,91 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
   const std::string picture_name = context.text("picture_muscle");
   const atlas::Muscle* pictured = atlas.find_muscle(picture_name);
   if (pictured == nullptr) pictured = muscles.front();
-  std::vector<fibres::Fibre> pictured_fibres;
-  mesh::IndexedMesh pictured_surface;
-  for (std::size_t m = 0; m < muscles.size(); ++m) {
+  // Each muscle on a worker thread; the outputs are written in muscle order
+  // afterwards, so they do not depend on the number of threads.
+  std::vector<MuscleResult> results(muscles.size());
+  std::mutex progress_mutex;
+  std::size_t done = 0;
+  const int threads = context.integer("threads") > 0
+                          ? static_cast<int>(context.integer("threads"))
+                          : static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  parallel_for(muscles.size(), threads, [&](std::size_t m) {
     const atlas::Muscle& muscle = *muscles[m];
-    context.progress(static_cast<std::int64_t>(m), static_cast<std::int64_t>(muscles.size()),
-                     "fibres of " + muscle.name);
+    MuscleResult& out = results[m];
     const auto found = overrides.find(muscle.name);
-    const DecompositionMethod method = found != overrides.end() ? found->second : default_method;
+    out.method = found != overrides.end() ? found->second : default_method;
     fibres::DecompositionOptions muscle_options = options;
     muscle_options.architecture = muscle.architecture;
     const fibres::MuscleFibreModel model(
         muscle.name, wrapping::wrapping_surface(muscle, atlas_dir, context.integer("target_faces")),
-        fibres::attachment_samples(muscle, bone_surface), method, muscle_options);
-    const fibres::MuscleFibres rest = model.decompose_at_rest();
-    const fibres::FibreQuality quality = fibres::measure_fibre_quality(
-        model.rest(), rest.fibres, rest.attachments.origin, rest.attachments.insertion);
-    worst_inside = std::min(worst_inside, quality.inside_fraction);
-    if (&muscle == pictured) {
-      pictured_fibres = rest.fibres;
-      pictured_surface = model.rest();
+        fibres::attachment_samples(muscle, bone_surface), out.method, muscle_options);
+    out.rest = model.decompose_at_rest();
+    out.quality = fibres::measure_fibre_quality(
+        model.rest(), out.rest.fibres, out.rest.attachments.origin, out.rest.attachments.insertion);
+    if (&muscle == pictured) out.rest_surface = model.rest();
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      const AnimationFrame& frame = frames[k];
+      const auto part = frame.parts.find(muscle.name);
+      if (part == frame.parts.end()) {
+        throw InvalidInputError("decompose_fibres: the animation has no muscle '" + muscle.name +
+                                "' at time " + fixed(frame.time, 4) +
+                                "; hint: wrap the same muscles");
+      }
+      const mesh::IndexedMesh wrapped = mesh::read_vtp(part->second);
+      fibres::MuscleFibres result = model.decompose(
+          wrapped.V, [&](const std::string& bone) { return poses.pose(bone, k, frame); });
+      out.frame_seconds += result.seconds;
+      out.frames_inside =
+          std::min(out.frames_inside, fibres::inside_fraction(wrapped, result.fibres));
+      out.frames.push_back(std::move(result.fibres));
     }
-    const auto add_frame = [&](const fibres::MuscleFibres& result, int frame, double time) {
-      series.add_polylines(time, frame, muscle.name, as_polylines(result.fibres));
-      for (std::size_t f = 0; f < result.fibres.size(); ++f) {
-        csv += muscle.name + "," + std::string(fibres::method_name(method)) + "," +
+    out.field_seconds = model.field_seconds();
+    const std::scoped_lock lock(progress_mutex);
+    context.progress(static_cast<std::int64_t>(++done), static_cast<std::int64_t>(muscles.size()),
+                     "fibres of " + muscle.name);
+  });
+
+  std::vector<fibres::Fibre> pictured_fibres;
+  mesh::IndexedMesh pictured_surface;
+  for (std::size_t m = 0; m < muscles.size(); ++m) {
+    const atlas::Muscle& muscle = *muscles[m];
+    MuscleResult& result = results[m];
+    worst_inside = std::min(worst_inside, result.quality.inside_fraction);
+    if (&muscle == pictured) {
+      pictured_fibres = result.rest.fibres;
+      pictured_surface = std::move(result.rest_surface);
+    }
+    const auto add_frame = [&](const std::vector<fibres::Fibre>& fibres, int frame, double time) {
+      series.add_polylines(time, frame, muscle.name, as_polylines(fibres));
+      for (std::size_t f = 0; f < fibres.size(); ++f) {
+        csv += muscle.name + "," + std::string(fibres::method_name(result.method)) + "," +
                std::to_string(f) + "," + std::to_string(frame) + "," + fixed(time, 4) + "," +
-               fixed(fibres::fibre_length(result.fibres[f]), 3) + "\n";
+               fixed(fibres::fibre_length(fibres[f]), 3) + "\n";
       }
     };
-    double frame_seconds = 0.0;
-    double frames_inside = 1.0;  // the worst frame's inside fraction, against that frame's surface
     if (frames.empty()) {
-      add_frame(rest, 0, 0.0);
+      add_frame(result.rest.fibres, 0, 0.0);
     } else {
       for (std::size_t k = 0; k < frames.size(); ++k) {
-        const AnimationFrame& frame = frames[k];
-        const auto part = frame.parts.find(muscle.name);
-        if (part == frame.parts.end()) {
-          throw InvalidInputError("decompose_fibres: the animation has no muscle '" + muscle.name +
-                                  "' at time " + fixed(frame.time, 4) +
-                                  "; hint: wrap the same muscles");
-        }
-        const mesh::IndexedMesh wrapped = mesh::read_vtp(part->second);
-        const fibres::MuscleFibres result = model.decompose(
-            wrapped.V, [&](const std::string& bone) { return poses.pose(bone, k, frame); });
-        frame_seconds += result.seconds;
-        frames_inside = std::min(frames_inside, fibres::inside_fraction(wrapped, result.fibres));
-        add_frame(result, static_cast<int>(k), frame.time);
+        add_frame(result.frames[k], static_cast<int>(k), frames[k].time);
       }
     }
-    nlohmann::json row = quality;
+    result.frames.clear();
+    nlohmann::json row = result.quality;
     row["muscle"] = muscle.name;
-    row["method"] = std::string(fibres::method_name(method));
-    row["stand_in_measured"] = rest.stand_in_measured;
-    row["moved_inside"] = rest.moved_inside;
-    row["rest_ms"] = 1000.0 * rest.seconds;
-    row["field_ms"] = 1000.0 * model.field_seconds();
+    row["method"] = std::string(fibres::method_name(result.method));
+    row["stand_in_measured"] = result.rest.stand_in_measured;
+    row["moved_inside"] = result.rest.moved_inside;
+    row["rest_ms"] = 1000.0 * result.rest.seconds;
+    row["field_ms"] = 1000.0 * result.field_seconds;
     row["frames"] = frames.size();
-    row["frames_ms"] = 1000.0 * frame_seconds;
-    row["frames_min_inside_fraction"] = frames_inside;
-    worst_inside = std::min(worst_inside, frames_inside);
+    row["frames_ms"] = 1000.0 * result.frame_seconds;
+    row["frames_min_inside_fraction"] = result.frames_inside;
+    worst_inside = std::min(worst_inside, result.frames_inside);
     // The tendons the segmentation left out: from the muscle's end patches
     // (where the fibres end) to the bone areas, at rest.
-    row["origin_tendon_gap_mm"] = rest.origin_gap_mm;
-    row["insertion_tendon_gap_mm"] = rest.insertion_gap_mm;
+    row["origin_tendon_gap_mm"] = result.rest.origin_gap_mm;
+    row["insertion_tendon_gap_mm"] = result.rest.insertion_gap_mm;
     rows.push_back(row);
   }
   if (worst_inside < 0.99) {

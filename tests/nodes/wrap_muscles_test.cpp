@@ -202,6 +202,31 @@ TEST(DecomposeFibresNodeTest, FibresFollowTheWrappedMuscleFrameByFrame) {
                InvalidInputError);
 }
 
+// Muscles are decomposed in parallel and written in muscle order: the
+// fibres and lengths are the same to the byte on one thread or on two.
+TEST(DecomposeFibresNodeTest, TheOutputsDoNotDependOnTheNumberOfThreads) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.7, 0.0, true);
+  ASSERT_EQ(toy.leg.atlas.muscles.size(), 2U);
+  const auto wrapped = harness.run<WrapMuscles>({{"atlas", toy.atlas}, {"motion", toy.motion}},
+                                                {{"animation_stride", std::int64_t{6}}});
+  const auto decompose = [&](std::int64_t threads) {
+    return harness.run<DecomposeFibres>(
+        {{"atlas", toy.atlas}, {"animation", wrapped.at("animation")}},
+        {{"fibres", std::int64_t{16}}, {"segments", std::int64_t{8}}, {"threads", threads}});
+  };
+  const auto one = decompose(1);
+  const auto two = decompose(2);
+  for (const char* output : {"fibres", "lengths"}) {
+    EXPECT_EQ(mmm::test::read_text(one.at(output).path), mmm::test::read_text(two.at(output).path))
+        << output;
+  }
+  const nlohmann::json report = nlohmann::json::parse(mmm::test::read_text(two.at("report").path));
+  ASSERT_EQ(report["muscles"].size(), 2U);
+  EXPECT_EQ(report["muscles"][0]["muscle"], toy.leg.atlas.muscles[0].name);
+  EXPECT_EQ(report["muscles"][1]["muscle"], toy.leg.atlas.muscles[1].name);
+}
+
 TEST(WrapMusclesNodeTest, StoredHullsAreReusedWhileTheSurfaceAndFaceCountMatch) {
   test::NodeHarness harness;
   const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.55);
