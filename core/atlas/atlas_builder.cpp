@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <thread>
 
 #include "core/atlas/action_line_fit.h"
 #include "core/atlas/atlas_io.h"
@@ -33,6 +34,7 @@
 #include "core/opensim/kinematics.h"
 #include "core/opensim/marker_set.h"
 #include "core/opensim/osim_model.h"
+#include "core/parallel_for.h"
 
 namespace mmm::atlas {
 namespace {
@@ -657,7 +659,17 @@ void Builder::clean_and_attach() {
   AttachmentOptions attachment;
   attachment.contact_distance_mm = recipe_.attachment_distance_mm;
   attachment.radius_mm = recipe_.attachment_radius_mm;
-  for (Muscle& muscle : atlas_.muscles) {
+  // Each muscle on the machine's threads (nothing shared is written), its
+  // report entries gathered and appended in muscle order.
+  struct MuscleEntries {
+    MuscleBuildReport muscle;
+    std::vector<ActionLineBuildReport> lines;
+    std::vector<std::string> notes;
+  };
+  std::vector<MuscleEntries> entries(atlas_.muscles.size());
+  const auto clean_and_attach_muscle = [&](std::size_t index) {
+    Muscle& muscle = atlas_.muscles[index];
+    MuscleEntries& out = entries[index];
     mesh::IndexedMesh& surface = muscle_meshes_.at(muscle.name);
     Eigen::AlignedBox3d box = mesh::bounding_box(surface);
     box.min().array() -= 1.0;
@@ -675,7 +687,7 @@ void Builder::clean_and_attach() {
     muscle_report.vertices_moved = cleaned.vertices_moved;
     muscle_report.volume_change_percent =
         100.0 * (cleaned.volume_after_mm3 - cleaned.volume_before_mm3) / cleaned.volume_before_mm3;
-    report_.muscles.push_back(muscle_report);
+    out.muscle = muscle_report;
 
     const mesh::AabbTree muscle_tree(surface);
     const mesh::WindingNumber winding(muscle_tree);
@@ -689,9 +701,9 @@ void Builder::clean_and_attach() {
     for (const ActionLineFitReport& fitted : fit_action_lines(
              muscle, muscle_tree, [&](const Eigen::Vector3d& q) { return winding.is_inside(q); },
              trees, muscle_fit)) {
-      report_.action_lines.push_back({muscle.name, fitted.line, fitted.inside_before,
-                                      fitted.inside_after, fitted.points_added,
-                                      fitted.origin_on_contact, fitted.insertion_on_contact});
+      out.lines.push_back({muscle.name, fitted.line, fitted.inside_before, fitted.inside_after,
+                           fitted.points_added, fitted.origin_on_contact,
+                           fitted.insertion_on_contact});
     }
     const auto add_area = [&](std::vector<AttachmentArea>& areas, const PathPoint& end,
                               const std::string& which) {
@@ -699,10 +711,10 @@ void Builder::clean_and_attach() {
       const AttachmentArea area = find_attachment_area(end.bone, *trees.at(end.bone), muscle_tree,
                                                        end.position, attachment, &fell_back);
       if (fell_back) {
-        report_.notes.push_back(muscle.name + ": no muscle-bone contact near its " + which +
-                                " on " + end.bone +
-                                "; the area is the bone patch nearest the "
-                                "action line's end");
+        out.notes.push_back(muscle.name + ": no muscle-bone contact near its " + which + " on " +
+                            end.bone +
+                            "; the area is the bone patch nearest the "
+                            "action line's end");
       }
       const auto same_bone = std::ranges::find_if(
           areas, [&](const AttachmentArea& other) { return other.bone == area.bone; });
@@ -717,6 +729,14 @@ void Builder::clean_and_attach() {
       add_area(muscle.origins, line.points.front(), "origin");
       add_area(muscle.insertions, line.points.back(), "insertion");
     }
+  };
+  parallel_for(atlas_.muscles.size(),
+               static_cast<int>(std::max(1U, std::thread::hardware_concurrency())),
+               clean_and_attach_muscle);
+  for (MuscleEntries& entry : entries) {
+    report_.muscles.push_back(std::move(entry.muscle));
+    for (ActionLineBuildReport& line : entry.lines) report_.action_lines.push_back(std::move(line));
+    for (std::string& note : entry.notes) report_.notes.push_back(std::move(note));
   }
 }
 
@@ -744,17 +764,30 @@ std::vector<MeshLevel> write_levels(const std::filesystem::path& dir, const std:
 }
 
 void Builder::write(const std::filesystem::path& out_dir) {
-  for (Bone& bone : atlas_.bones) {
-    bone.meshes = write_levels(out_dir, bone.name, bone_meshes_.at(bone.name), recipe_.lod_faces);
-  }
+  // Every element's levels (simplified and written) on the machine's
+  // threads: each writes its own files, so the order does not matter.
+  struct Job {
+    const std::string* name;
+    const mesh::IndexedMesh* surface;
+    std::vector<MeshLevel>* levels;
+  };
+  std::vector<Job> jobs;
+  for (Bone& bone : atlas_.bones)
+    jobs.push_back({&bone.name, &bone_meshes_.at(bone.name), &bone.meshes});
   for (Muscle& muscle : atlas_.muscles) {
-    muscle.meshes =
-        write_levels(out_dir, muscle.name, muscle_meshes_.at(muscle.name), recipe_.lod_faces);
+    jobs.push_back({&muscle.name, &muscle_meshes_.at(muscle.name), &muscle.meshes});
   }
   for (Structure& structure : atlas_.structures) {
-    structure.meshes = write_levels(out_dir, structure.name, structure_meshes_.at(structure.name),
-                                    recipe_.lod_faces);
+    jobs.push_back({&structure.name, &structure_meshes_.at(structure.name), &structure.meshes});
   }
+  // Largest first, so the last one to start is a small one.
+  std::ranges::sort(
+      jobs, [](const Job& a, const Job& b) { return a.surface->F.rows() > b.surface->F.rows(); });
+  parallel_for(jobs.size(), static_cast<int>(std::max(1U, std::thread::hardware_concurrency())),
+               [&](std::size_t i) {
+                 *jobs[i].levels =
+                     write_levels(out_dir, *jobs[i].name, *jobs[i].surface, recipe_.lod_faces);
+               });
   write_atlas_manifest(atlas_, out_dir);
 }
 
