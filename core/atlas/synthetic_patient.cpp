@@ -17,6 +17,7 @@
 #include "core/mesh/aabb_tree.h"
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/mass_properties.h"
+#include "core/parallel_for.h"
 
 namespace mmm::atlas {
 namespace {
@@ -72,18 +73,26 @@ PatientMeshes write_patient_meshes(const Atlas& atlas, const std::filesystem::pa
       mesh::write_mesh(deformed, dir / level.file);
     }
   }
-  for (const Muscle& muscle : atlas.muscles) {
+  // Muscles on `options.threads` threads, each writing its own files; the
+  // kept surfaces are gathered in muscle order.
+  std::vector<mesh::IndexedMesh> kept(atlas.muscles.size());
+  parallel_for(atlas.muscles.size(), options.threads, [&](std::size_t m) {
+    const Muscle& muscle = atlas.muscles[m];
+    bool chosen = false;
     for (const MeshLevel& level : muscle.meshes) {
-      const mesh::IndexedMesh deformed = deform_muscle_mesh(
+      mesh::IndexedMesh deformed = deform_muscle_mesh(
           deformation, blend_bones, load_mesh(atlas_dir, muscle.meshes, level.level),
           options.deformation.blend_radius_mm);
       std::filesystem::create_directories((dir / level.file).parent_path());
       mesh::write_mesh(deformed, dir / level.file);
-      if (level.level == options.muscle_level ||
-          (level.level == "full" && !meshes.muscles.contains(muscle.name))) {
-        meshes.muscles[muscle.name] = deformed;
+      if (level.level == options.muscle_level || (level.level == "full" && !chosen)) {
+        chosen = chosen || level.level == options.muscle_level;
+        kept[m] = std::move(deformed);
       }
     }
+  });
+  for (std::size_t m = 0; m < atlas.muscles.size(); ++m) {
+    meshes.muscles[atlas.muscles[m].name] = std::move(kept[m]);
   }
   return meshes;
 }

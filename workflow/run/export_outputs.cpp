@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <system_error>
+#include <vector>
 
 #include "core/directory_bundle.h"
 #include "core/errors.h"
@@ -87,12 +88,27 @@ const OutputArtifact* current_artifact(
   return port == node->second.end() ? nullptr : &port->second;
 }
 
-// Whether two files hold the same bytes (sizes first).
+// Whether two files hold the same bytes (sizes first, then 1 MiB at a time:
+// an exported animation is hundreds of MB).
 bool same_content(const std::filesystem::path& a, const std::filesystem::path& b) {
   std::error_code error;
   const std::uintmax_t size = std::filesystem::file_size(a, error);
   if (error || size != std::filesystem::file_size(b, error) || error) return false;
-  return read_all(a) == read_all(b);
+  std::ifstream in_a(a, std::ios::binary);
+  std::ifstream in_b(b, std::ios::binary);
+  if (!in_a || !in_b) return false;
+  constexpr std::size_t kChunk = std::size_t{1} << 20;
+  std::vector<char> chunk_a(kChunk);
+  std::vector<char> chunk_b(kChunk);
+  for (std::uintmax_t left = size; left > 0;) {
+    const auto n = static_cast<std::streamsize>(std::min<std::uintmax_t>(left, kChunk));
+    in_a.read(chunk_a.data(), n);
+    in_b.read(chunk_b.data(), n);
+    if (in_a.gcount() != n || in_b.gcount() != n) return false;
+    if (!std::equal(chunk_a.begin(), chunk_a.begin() + n, chunk_b.begin())) return false;
+    left -= static_cast<std::uintmax_t>(n);
+  }
+  return true;
 }
 
 // Whether the first line is a CSV header: names separated by at least one
