@@ -34,6 +34,17 @@ ActionLineFitOptions without_shift_limits() {
   return options;
 }
 
+// The straight tube muscle with one action line, "tube_line", through `points`.
+Muscle tube_muscle(std::vector<PathPoint> points) {
+  Muscle muscle;
+  muscle.name = "tube";
+  ActionLine line;
+  line.name = "tube_line";
+  line.points = std::move(points);
+  muscle.action_lines = {line};
+  return muscle;
+}
+
 // A closed tube of radius r swept along a centre line: rings of kSegments
 // vertices around centres[k] in the plane spanned by u[k], v[k] (unit,
 // perpendicular to the line), closed by a fan around each end's centre.
@@ -159,14 +170,10 @@ TEST(ActionLineFitTest, TubeSurfaceIsAClosedSolid) {
 
 TEST(ActionLineFitTest, LineBesideAStraightMuscleMovesInsideAndOntoTheContacts) {
   const auto scene = straight_scene();
-  Muscle muscle;
-  muscle.name = "tube";
-  ActionLine line;
-  line.name = "tube_line";
   // 12 mm off the axis: entirely outside the 10 mm tube.
-  line.points = {point("origin", "top", {12, 0, 103}), point("via", "bottom", {12, 0, 50}),
-                 point("insertion", "bottom", {12, 0, -3})};
-  muscle.action_lines = {line};
+  Muscle muscle =
+      tube_muscle({point("origin", "top", {12, 0, 103}), point("via", "bottom", {12, 0, 50}),
+                   point("insertion", "bottom", {12, 0, -3})});
 
   const auto reports =
       fit_action_lines(muscle, scene->tree, scene->inside, scene->bones, without_shift_limits());
@@ -202,18 +209,15 @@ TEST(ActionLineFitTest, AnEndFarFromTheContactStaysWhereTheModelPutsIt) {
   // The belly ends short of a long tendon: its contact with the bone, 40 mm
   // from the model's origin, is not where the tendon attaches.
   const auto scene = straight_scene();
-  Muscle muscle;
-  muscle.name = "tube";
-  ActionLine line;
-  line.name = "tube_line";
-  line.points = {point("origin", "top", {40, 0, 100}), point("insertion", "bottom", {5, 0, -3})};
-  muscle.action_lines = {line};
+  const Muscle original =
+      tube_muscle({point("origin", "top", {40, 0, 100}), point("insertion", "bottom", {5, 0, -3})});
+  Muscle muscle = original;
   const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones);
   EXPECT_FALSE(reports.front().origin_on_contact);
   EXPECT_TRUE(reports.front().insertion_on_contact);
   EXPECT_EQ(muscle.action_lines.front().points.front().position, Eigen::Vector3d(40, 0, 100));
   // Allowed a longer shift, it moves onto the contact.
-  muscle.action_lines = {line};
+  muscle = original;
   ActionLineFitOptions far;
   far.max_end_shift_mm = 45;
   const auto moved = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones, far);
@@ -228,13 +232,10 @@ TEST(ActionLineFitTest, AViaPointFarFromItsSectionCentreStaysAndTheDrawnPathBend
   // bone, beside a thick belly): beyond the 15 mm limit it keeps its place,
   // and the points added to keep the path inside only follow the line.
   const auto scene = straight_scene();
-  Muscle muscle;
-  muscle.name = "tube";
-  ActionLine line;
-  line.name = "tube_line";
-  line.points = {point("origin", "top", {0, 0, 103}), point("via", "bottom", {25, 0, 50}),
-                 point("insertion", "bottom", {0, 0, -3})};
-  muscle.action_lines = {line};
+  const Muscle original =
+      tube_muscle({point("origin", "top", {0, 0, 103}), point("via", "bottom", {25, 0, 50}),
+                   point("insertion", "bottom", {0, 0, -3})});
+  Muscle muscle = original;
   const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones);
   const ActionLine& kept = muscle.action_lines.front();
   const auto via =
@@ -248,7 +249,7 @@ TEST(ActionLineFitTest, AViaPointFarFromItsSectionCentreStaysAndTheDrawnPathBend
     }
   }
   // Allowed a longer shift, it moves onto the section's centre, on the axis.
-  muscle.action_lines = {line};
+  muscle = original;
   ActionLineFitOptions far;
   far.max_via_shift_mm = 30;
   fit_action_lines(muscle, scene->tree, scene->inside, scene->bones, far);
@@ -262,12 +263,8 @@ TEST(ActionLineFitTest, NoEndLandsOnAnArticularSurface) {
   // The top bone's face is articular on its x < 0 half: the contacts there
   // do not count, and the origin moves onto the other half.
   const auto scene = straight_scene();
-  Muscle muscle;
-  muscle.name = "tube";
-  ActionLine line;
-  line.name = "tube_line";
-  line.points = {point("origin", "top", {0, 0, 103}), point("insertion", "bottom", {0, 0, -3})};
-  muscle.action_lines = {line};
+  Muscle muscle =
+      tube_muscle({point("origin", "top", {0, 0, 103}), point("insertion", "bottom", {0, 0, -3})});
   ActionLineFitOptions options;
   options.articular = [](const Eigen::Vector3d& p) { return p.z() >= 99.0 && p.x() < 0.0; };
   const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones, options);
@@ -385,14 +382,9 @@ TEST(ActionLineFitTest, SplitPointsRideOnTheNearestBoneAlongTheChain) {
 
 TEST(ActionLineFitTest, MovingPointsStay) {
   const auto scene = straight_scene();
-  Muscle muscle;
-  muscle.name = "tube";
-  ActionLine line;
-  line.name = "tube_line";
-  line.points = {point("origin", "top", {18, 0, 103}, PathPointKind::kMoving),
-                 point("via", "bottom", {0, 0, 50}, PathPointKind::kMoving),
-                 point("insertion", "bottom", {0, 0, -3})};
-  muscle.action_lines = {line};
+  Muscle muscle = tube_muscle({point("origin", "top", {18, 0, 103}, PathPointKind::kMoving),
+                               point("via", "bottom", {0, 0, 50}, PathPointKind::kMoving),
+                               point("insertion", "bottom", {0, 0, -3})});
   const auto reports = fit_action_lines(muscle, scene->tree, scene->inside, scene->bones);
   ASSERT_EQ(reports.size(), 1U);
   EXPECT_FALSE(reports.front().origin_on_contact);
@@ -437,12 +429,8 @@ TEST(ActionLineFitTest, TwoLinesShareTheMuscleIntoBundles) {
 
 TEST(ActionLineFitTest, UnknownBoneThrows) {
   const auto scene = straight_scene();
-  Muscle muscle;
-  muscle.name = "tube";
-  ActionLine line;
-  line.name = "tube_line";
-  line.points = {point("origin", "skull", {0, 0, 101}), point("insertion", "bottom", {0, 0, -1})};
-  muscle.action_lines = {line};
+  Muscle muscle = tube_muscle(
+      {point("origin", "skull", {0, 0, 101}), point("insertion", "bottom", {0, 0, -1})});
   EXPECT_THROW((void)fit_action_lines(muscle, scene->tree, scene->inside, scene->bones),
                InvalidInputError);
 }
