@@ -1,7 +1,7 @@
 #pragma once
 // job(i) for every i in [0, count) on `threads` threads (the caller's among
-// them), items handed out one at a time so uneven jobs balance. The first
-// exception stops the handing out and is rethrown once every thread is done.
+// them; machine_threads() for all the machine has), items handed out one at a time so uneven jobs
+// balance. The first exception stops the handing out and is rethrown once every thread is done.
 
 #include <algorithm>
 #include <atomic>
@@ -12,6 +12,11 @@
 #include <vector>
 
 namespace mmm {
+
+// The machine's hardware threads, at least 1.
+inline int machine_threads() {
+  return static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+}
 
 template <typename Job>
 void parallel_for(std::size_t count, int threads, const Job& job) {

@@ -8,7 +8,6 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -244,9 +243,8 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
   std::vector<MuscleResult> results(muscles.size());
   std::mutex progress_mutex;
   std::size_t done = 0;
-  const int threads = context.integer("threads") > 0
-                          ? static_cast<int>(context.integer("threads"))
-                          : static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  const int threads = context.integer("threads") > 0 ? static_cast<int>(context.integer("threads"))
+                                                     : machine_threads();
   parallel_for(muscles.size(), threads, [&](std::size_t m) {
     const atlas::Muscle& muscle = *muscles[m];
     MuscleResult& out = results[m];

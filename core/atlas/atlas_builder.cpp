@@ -8,7 +8,6 @@
 #include <memory>
 #include <optional>
 #include <set>
-#include <thread>
 
 #include "core/atlas/action_line_fit.h"
 #include "core/atlas/atlas_io.h"
@@ -730,9 +729,7 @@ void Builder::clean_and_attach() {
       add_area(muscle.insertions, line.points.back(), "insertion");
     }
   };
-  parallel_for(atlas_.muscles.size(),
-               static_cast<int>(std::max(1U, std::thread::hardware_concurrency())),
-               clean_and_attach_muscle);
+  parallel_for(atlas_.muscles.size(), machine_threads(), clean_and_attach_muscle);
   for (MuscleEntries& entry : entries) {
     report_.muscles.push_back(std::move(entry.muscle));
     for (ActionLineBuildReport& line : entry.lines) report_.action_lines.push_back(std::move(line));
@@ -783,11 +780,9 @@ void Builder::write(const std::filesystem::path& out_dir) {
   // Largest first, so the last one to start is a small one.
   std::ranges::sort(
       jobs, [](const Job& a, const Job& b) { return a.surface->F.rows() > b.surface->F.rows(); });
-  parallel_for(jobs.size(), static_cast<int>(std::max(1U, std::thread::hardware_concurrency())),
-               [&](std::size_t i) {
-                 *jobs[i].levels =
-                     write_levels(out_dir, *jobs[i].name, *jobs[i].surface, recipe_.lod_faces);
-               });
+  parallel_for(jobs.size(), machine_threads(), [&](std::size_t i) {
+    *jobs[i].levels = write_levels(out_dir, *jobs[i].name, *jobs[i].surface, recipe_.lod_faces);
+  });
   write_atlas_manifest(atlas_, out_dir);
 }
 

@@ -78,17 +78,17 @@ PatientMeshes write_patient_meshes(const Atlas& atlas, const std::filesystem::pa
   std::vector<mesh::IndexedMesh> kept(atlas.muscles.size());
   parallel_for(atlas.muscles.size(), options.threads, [&](std::size_t m) {
     const Muscle& muscle = atlas.muscles[m];
-    bool chosen = false;
+    // The level kept: options.muscle_level when the muscle has it, else full.
+    const bool has_level = std::ranges::any_of(
+        muscle.meshes, [&](const MeshLevel& l) { return l.level == options.muscle_level; });
+    const std::string keep = has_level ? options.muscle_level : "full";
     for (const MeshLevel& level : muscle.meshes) {
       mesh::IndexedMesh deformed = deform_muscle_mesh(
           deformation, blend_bones, load_mesh(atlas_dir, muscle.meshes, level.level),
           options.deformation.blend_radius_mm);
       std::filesystem::create_directories((dir / level.file).parent_path());
       mesh::write_mesh(deformed, dir / level.file);
-      if (level.level == options.muscle_level || (level.level == "full" && !chosen)) {
-        chosen = chosen || level.level == options.muscle_level;
-        kept[m] = std::move(deformed);
-      }
+      if (level.level == keep) kept[m] = std::move(deformed);
     }
   });
   for (std::size_t m = 0; m < atlas.muscles.size(); ++m) {

@@ -9,7 +9,6 @@
 #include <optional>
 #include <set>
 #include <string>
-#include <thread>
 #include <utility>
 
 #include "core/errors.h"
@@ -594,7 +593,7 @@ MuscleWrapping wrap_muscles(const atlas::Atlas& atlas, const std::filesystem::pa
     result.bone_poses.push_back(bone_poses(pose, bones));
   }
 
-  const int hardware = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  const int hardware = machine_threads();
   const int threads = std::clamp(options.threads > 0 ? options.threads : hardware, 1,
                                  static_cast<int>(std::max<std::size_t>(1, muscles.size())));
   result.threads = threads;
