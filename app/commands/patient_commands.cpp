@@ -12,6 +12,9 @@
 #include <string>
 
 #include "app/commands/commands.h"
+#include "core/atlas/bone_set.h"
+#include "core/atlas/bone_set_patient.h"
+#include "core/atlas/foreign_bones.h"
 #include "core/atlas/synthetic_patient.h"
 #include "core/errors.h"
 #include "core/landmarks/scripted_clicks.h"
@@ -25,6 +28,7 @@ struct SynthArgs {
   std::uint64_t seed = 1;
   std::optional<double> height_mm;
   double pixel_pitch_mm = 0.5;
+  bool local_shape = false;
   bool json = false;
 };
 
@@ -33,6 +37,7 @@ void run_synth(const SynthArgs& args) {
   options.deformation.seed = args.seed;
   options.deformation.height_mm = args.height_mm;
   options.detector_pixel_pitch_mm = args.pixel_pitch_mm;
+  options.deformation.local_shape = args.local_shape;
   const atlas::SyntheticPatientReport report =
       atlas::make_synthetic_patient(args.atlas, args.out, options);
   if (args.json) {
@@ -65,6 +70,55 @@ void run_synth(const SynthArgs& args) {
             << " in " << std::setprecision(1) << report.seconds << " s\n"
             << "  " << args.out << "/atlas (ground truth), ground_truth.json, radiographs/"
             << "{frontal,lateral}.png + views.json\n";
+}
+
+struct BonesArgs {
+  std::string manifest;  // from-bones
+  std::string data;      // foreign
+  std::string atlas;
+  std::string out;
+  std::uint64_t seed = 1;
+  std::optional<double> height_mm;
+  double pixel_pitch_mm = 0.5;
+  bool local_shape = false;
+};
+
+void print_bone_patient(const atlas::BoneSetPatientReport& report, const std::string& out) {
+  std::cout << std::fixed << std::setprecision(1) << "patient of " << report.bones
+            << " bones: " << report.landmarks_given << " landmarks given, "
+            << report.landmarks_derived << " derived from the atlas; radiographs "
+            << report.frontal_width << " x " << report.frontal_height << " px, "
+            << std::setprecision(3) << report.pixel_spacing_mm
+            << " mm/px at the isocentre; written to " << out << " in " << std::setprecision(1)
+            << report.seconds << " s\n"
+            << "  " << out << "/bones (ground truth), ground_truth.json, radiographs/"
+            << "{frontal,lateral}.png + views.json\n";
+}
+
+atlas::PatientRadiographOptions radiograph_options(const BonesArgs& args) {
+  atlas::PatientRadiographOptions options;
+  options.detector_pixel_pitch_mm = args.pixel_pitch_mm;
+  options.seed = args.seed;
+  return options;
+}
+
+void run_from_bones(const BonesArgs& args) {
+  const atlas::BoneSet set = atlas::read_bone_set(args.manifest);
+  print_bone_patient(
+      atlas::make_bone_set_patient(set, args.atlas, args.out, radiograph_options(args)), args.out);
+}
+
+void run_foreign(const BonesArgs& args) {
+  atlas::ForeignBoneOptions options;
+  options.deformation.seed = args.seed;
+  options.deformation.height_mm = args.height_mm;
+  options.deformation.local_shape = args.local_shape;
+  const atlas::BoneSet set = atlas::gait2392_bone_set(args.atlas, args.data, options);
+  const atlas::BoneSetPatientReport report =
+      atlas::make_bone_set_patient(set, args.atlas, args.out, radiograph_options(args));
+  atlas::write_bone_set(set, std::filesystem::path(args.out) / "bone_set");
+  print_bone_patient(report, args.out);
+  std::cout << "  " << args.out << "/bone_set/manifest.yaml: the bones as a bone set\n";
 }
 
 struct ClickArgs {
@@ -118,8 +172,45 @@ void register_patient_commands(CLI::App& app) {
       ->add_option("--pixel-pitch", args->pixel_pitch_mm,
                    "Detector pixel pitch (mm); 0.5 gives 0.38 mm at the isocentre")
       ->check(CLI::Range(0.05, 2.0));
+  synth->add_flag("--local-shape", args->local_shape,
+                  "Add local shape to the long bones (torsion, bowing, bumps): what no smooth "
+                  "map of the atlas produces");
   synth->add_flag("--json", args->json, "Print the drawn factors as JSON");
   synth->callback([args] { run_synth(*args); });
+
+  auto bones = std::make_shared<BonesArgs>();
+  auto* from_bones = patient->add_subcommand(
+      "from-bones",
+      "Make a patient folder (calibrated radiograph pair + ground truth) from any bone "
+      "surfaces (CT segmentations, another model) listed in a bone-set manifest");
+  from_bones->add_option("manifest", bones->manifest, "Bone-set manifest (YAML)")->required();
+  from_bones->add_option("--atlas", bones->atlas, "Atlas whose bone and landmark names apply")
+      ->required();
+  from_bones->add_option("-o,--out", bones->out, "Patient folder to write")->required();
+  from_bones->add_option("--seed", bones->seed, "Random seed of the detector noise");
+  from_bones
+      ->add_option("--pixel-pitch", bones->pixel_pitch_mm,
+                   "Detector pixel pitch (mm); 0.5 gives 0.38 mm at the isocentre")
+      ->check(CLI::Range(0.05, 2.0));
+  from_bones->callback([bones] { run_from_bones(*bones); });
+
+  auto foreign = std::make_shared<BonesArgs>();
+  auto* foreign_command = patient->add_subcommand(
+      "foreign",
+      "A patient with another person's bones: gait2392's bone geometry placed on the atlas, "
+      "given a synthetic patient's proportions (and local shape), rendered like from-bones");
+  foreign_command->add_option("--atlas", foreign->atlas, "Atlas folder")->required();
+  foreign_command->add_option("--data", foreign->data, "The shared data folder (gait2392/)")
+      ->required();
+  foreign_command->add_option("-o,--out", foreign->out, "Patient folder to write")->required();
+  foreign_command->add_option("--seed", foreign->seed, "Random seed of the proportions and noise");
+  foreign_command->add_option("--height-mm", foreign->height_mm, "Stature (mm), 1000-2300")
+      ->check(CLI::Range(1000.0, 2300.0));
+  foreign_command->add_flag("--local-shape", foreign->local_shape,
+                            "Add local shape to the long bones (torsion, bowing, bumps)");
+  foreign_command->add_option("--pixel-pitch", foreign->pixel_pitch_mm, "Detector pixel pitch (mm)")
+      ->check(CLI::Range(0.05, 2.0));
+  foreign_command->callback([foreign] { run_foreign(*foreign); });
 
   auto clicks = std::make_shared<ClickArgs>();
   auto* click = patient->add_subcommand(

@@ -53,7 +53,29 @@ Eigen::Vector3d PatientDeformation::map_on_bone(const std::string& bone,
   if (map == bone_maps.end()) {
     throw InvalidInputError("patient deformation: no map for bone '" + bone + "'");
   }
-  return map->second * (bone == neck.bone ? neck.apply(point) : point);
+  Eigen::Vector3d warped = point;
+  if (const auto warp = local.find(bone); warp != local.end()) warped = warp->second.apply(warped);
+  return map->second * (bone == neck.bone ? neck.apply(warped) : warped);
+}
+
+Eigen::Vector3d LocalWarp::apply(const Eigen::Vector3d& point) const {
+  const Eigen::Vector3d offset = point - proximal;
+  const double t = offset.dot(axis);
+  const double s = std::clamp(t / length, 0.0, 1.0);
+  Eigen::Vector3d out = proximal + Eigen::AngleAxisd(s * torsion_rad, axis) * offset;
+  out += std::sin(std::numbers::pi * s) * bow;
+  const Eigen::Vector3d radial = offset - t * axis;
+  if (radial.norm() > 1e-9 && !bumps.empty()) {
+    const Eigen::Vector3d r = radial.normalized();
+    const double phi = std::atan2(axis.cross(reference).dot(r), reference.dot(r));
+    for (const Bump& bump : bumps) {
+      const double d_phi = std::remainder(phi - bump.angle_rad, 2 * std::numbers::pi);
+      const double along = (t - bump.along_mm) / bump_length_mm;
+      const double around = d_phi / bump_angle_rad;
+      out += bump.height_mm * std::exp(-0.5 * (along * along + around * around)) * r;
+    }
+  }
+  return out;
 }
 
 namespace {
@@ -111,6 +133,39 @@ PatientDeformation make_patient_deformation(const Atlas& atlas, const PatientOpt
   factors.neck_angle_deg = (draw(random, options.neck_angle_sd_deg / 100.0) - 1.0) * 100.0;
 
   const std::vector<const Bone*> order = chain_order(atlas, "patient deformation");
+  if (options.local_shape) {
+    // Drawn last, in atlas order, so that earlier factors do not change.
+    std::normal_distribution<double> normal;
+    std::uniform_real_distribution<double> uniform;
+    for (const Bone& bone : atlas.bones) {
+      const Joint* joint = joint_to(atlas, bone.name);
+      const std::optional<Eigen::Vector3d> distal = distal_joint_centre(atlas, bone.name);
+      if (joint == nullptr || joint->type == JointType::kWeld || !distal) continue;
+      const Eigen::Vector3d proximal = joint->child_frame.translation();
+      if ((*distal - proximal).norm() < 150.0) continue;  // long bones only
+      LocalWarp warp;
+      warp.proximal = proximal;
+      warp.length = (*distal - proximal).norm();
+      warp.axis = (*distal - proximal) / warp.length;
+      warp.reference = (Eigen::Vector3d::UnitX() - warp.axis.x() * warp.axis).normalized();
+      const auto clipped = [&] { return std::clamp(normal(random), -2.5, 2.5); };
+      warp.torsion_rad = clipped() * options.torsion_sd_deg * std::numbers::pi / 180.0;
+      const Eigen::Vector3d across = warp.axis.cross(warp.reference);
+      warp.bow = options.bowing_sd_mm * (clipped() * warp.reference + clipped() * across);
+      warp.bump_length_mm = options.bump_length_mm;
+      warp.bump_angle_rad = options.bump_angle_deg * std::numbers::pi / 180.0;
+      for (int k = 0; k < options.bumps_per_bone; ++k) {
+        LocalWarp::Bump bump;
+        bump.along_mm = (0.15 + 0.7 * uniform(random)) * warp.length;
+        bump.angle_rad = (2.0 * uniform(random) - 1.0) * std::numbers::pi;
+        bump.height_mm = clipped() * options.bump_sd_mm;
+        warp.bumps.push_back(bump);
+      }
+      factors.torsion_deg[bone.name] = warp.torsion_rad * 180.0 / std::numbers::pi;
+      factors.bowing_mm[bone.name] = warp.bow.norm();
+      deformation.local[bone.name] = warp;
+    }
+  }
   const Bone* root = order.front();
   deformation.neck = neck_warp_for(atlas, *root);
   if (!deformation.neck.bone.empty()) {

@@ -32,6 +32,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "core/atlas/atlas.h"
 #include "core/mesh/mesh.h"
@@ -56,6 +57,16 @@ struct PatientOptions {
   double neck_angle_sd_deg = 4.0;
   // Muscle blending: eps in w = 1 / (d^2 + eps^2) (mm).
   double blend_radius_mm = 10.0;
+  // Local shape (LocalWarp below) on the long bones (femur, tibia): what no
+  // smooth global map of the atlas produces. Off by default, so that a seed
+  // gives the same patient as before; drawn after every other factor.
+  bool local_shape = false;
+  double torsion_sd_deg = 7.0;  // twist of the distal end about the long axis
+  double bowing_sd_mm = 4.0;    // mid-shaft bend, per transverse direction
+  int bumps_per_bone = 3;
+  double bump_sd_mm = 1.5;       // radial height of a bump (either sign)
+  double bump_length_mm = 25.0;  // its extent along the bone (Gaussian sigma)
+  double bump_angle_deg = 40.0;  // its extent around the bone (Gaussian sigma)
 };
 
 // The drawn factors, kept with the patient as its ground truth.
@@ -64,9 +75,38 @@ struct PatientFactors {
   double height_mm = 0.0;
   double stature_scale = 1.0;
   double pelvis_width = 1.0;
-  double neck_angle_deg = 0.0;           // change of the femoral neck-shaft angle
-  std::map<std::string, double> length;  // bone -> segment-length factor
-  std::map<std::string, double> width;   // bone -> width factor
+  double neck_angle_deg = 0.0;                // change of the femoral neck-shaft angle
+  std::map<std::string, double> length;       // bone -> segment-length factor
+  std::map<std::string, double> width;        // bone -> width factor
+  std::map<std::string, double> torsion_deg;  // long bone -> twist (local shape only)
+  std::map<std::string, double> bowing_mm;    // long bone -> largest mid-shaft bend
+};
+
+// Local shape of a long bone, in atlas coordinates, applied before the
+// bone's affine map. With s = clamp((x - proximal) . axis / length, 0, 1):
+//   torsion  the point turns about the axis line by s * torsion_rad
+//   bowing   + sin(pi s) * bow (bow perpendicular to the axis)
+//   bumps    + sum_k h_k exp(-(t - t_k)^2 / 2 l^2 - (phi - phi_k)^2 / 2 a^2) r
+//            t the position along the axis (mm), phi the angle around it, r
+//            the unit radial direction: a swelling (h > 0) or a dent of one
+//            side of the shaft, fading along and around it.
+struct LocalWarp {
+  Eigen::Vector3d proximal = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = -Eigen::Vector3d::UnitZ();      // unit, toward the distal joint
+  Eigen::Vector3d reference = Eigen::Vector3d::UnitX();  // unit, perpendicular: phi = 0
+  double length = 0.0;                                   // mm
+  double torsion_rad = 0.0;
+  Eigen::Vector3d bow = Eigen::Vector3d::Zero();  // mm
+  struct Bump {
+    double along_mm = 0.0;
+    double angle_rad = 0.0;
+    double height_mm = 0.0;
+  };
+  std::vector<Bump> bumps;
+  double bump_length_mm = 25.0;
+  double bump_angle_rad = 0.7;
+
+  [[nodiscard]] Eigen::Vector3d apply(const Eigen::Vector3d& point) const;
 };
 
 // The femoral neck turn (see the file comment), in atlas coordinates.
@@ -89,6 +129,7 @@ struct PatientDeformation {
   PatientFactors factors;
   std::map<std::string, Eigen::Affine3d> bone_maps;
   NeckWarp neck;
+  std::map<std::string, LocalWarp> local;  // long bone -> its local shape (empty: none)
 
   [[nodiscard]] Eigen::Vector3d map_on_bone(const std::string& bone,
                                             const Eigen::Vector3d& point) const;

@@ -134,15 +134,9 @@ std::shared_ptr<const PreparedAtlas> prepare_atlas(atlas::Atlas atlas, atlas::At
 
 namespace {
 
-// The placed full surfaces and affine parts of the bones, filled in chain order.
-struct PlacedBones {
-  std::map<std::string, Eigen::MatrixX3d> vertices;
-  std::map<std::string, Affine3d> affine;
-};
-
 std::vector<PointTerm> bone_terms(const PreparedAtlas& prepared, const atlas::Bone& bone,
                                   const landmarks::LandmarkSet& set, const ScalingEstimate& first,
-                                  const PlacedBones& placed, const AtlasScalingOptions& options) {
+                                  const BonePlacement& placed, const AtlasScalingOptions& options) {
   const atlas::Atlas& a = prepared.atlas;
   const AnchorBuilder& anchors = *prepared.anchors.at(bone.name);
   std::vector<PointTerm> terms;
@@ -196,7 +190,8 @@ BoneScaling describe_bone(const atlas::Atlas& a, const atlas::Bone& bone, const 
   return out;
 }
 
-void place_elements(const PreparedAtlas& prepared, const PlacedBones& placed, ScaledAtlas& scaled) {
+void place_elements(const PreparedAtlas& prepared, const BonePlacement& placed,
+                    ScaledAtlas& scaled) {
   const atlas::Atlas& a = prepared.atlas;
   atlas::PatientDeformation maps;
   maps.bone_maps = placed.affine;
@@ -272,7 +267,7 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
 
   // Bones, root first.
   Clock::time_point stage = Clock::now();
-  PlacedBones placed;
+  BonePlacement placed;
   for (const atlas::Bone* bone : chain_order(a, "atlas scaling")) {
     const atlas::Joint* joint = joint_to(a, bone->name);
     const mesh::IndexedMesh& rest = full_mesh(prepared.meshes, bone->name);
@@ -299,6 +294,39 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
       placed.vertices[bone->name] = std::move(solution.vertices);
     }
     scaled.bones.push_back(std::move(report));
+  }
+  scaled.timings.bones_s = seconds_since(stage);
+  carry_atlas(prepared, placed, options, scaled);
+  for (const landmarks::Landmark& given : landmarks.landmarks) {
+    for (const atlas::Landmark& landmark : scaled.atlas.landmarks) {
+      if (landmark.name == given.name) {
+        scaled.landmark_residual_mm[given.name] = (landmark.position - given.position_mm).norm();
+      }
+    }
+  }
+  scaled.atlas.provenance.push_back(
+      "scaled by mmm scale_atlas onto " + std::to_string(landmarks.landmarks.size()) +
+      " landmarks (" + (landmarks.source.empty() ? "unknown source" : landmarks.source) +
+      ", frame " + landmarks.frame + ")");
+  scaled.timings.total_s = seconds_since(start);
+  return scaled;
+}
+
+void carry_atlas(const PreparedAtlas& prepared, const BonePlacement& placed,
+                 const AtlasScalingOptions& options, ScaledAtlas& scaled) {
+  const atlas::Atlas& a = prepared.atlas;
+  Clock::time_point stage = Clock::now();
+  for (const atlas::Bone& bone : a.bones) {
+    if (!placed.vertices.contains(bone.name) || !placed.affine.contains(bone.name)) {
+      throw InvalidInputError("carrying the atlas: bone '" + bone.name +
+                              "' has no placement; hint: place every bone of the atlas");
+    }
+    if (placed.vertices.at(bone.name).rows() != full_mesh(prepared.meshes, bone.name).V.rows()) {
+      throw InvalidInputError("carrying the atlas: bone '" + bone.name + "' is placed with " +
+                              std::to_string(placed.vertices.at(bone.name).rows()) +
+                              " vertices, its full mesh has " +
+                              std::to_string(full_mesh(prepared.meshes, bone.name).V.rows()));
+    }
   }
   for (const atlas::Bone& bone : a.bones) {
     std::map<std::string, mesh::IndexedMesh>& levels = scaled.meshes[bone.name];
@@ -331,7 +359,7 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
               : reconstruct_all(prepared.level_anchors.at(structure.name).at(level), full);
     }
   }
-  scaled.timings.bones_s = seconds_since(stage);
+  scaled.timings.bones_s += seconds_since(stage);
 
   // Muscles.
   stage = Clock::now();
@@ -367,20 +395,7 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
 
   stage = Clock::now();
   place_elements(prepared, placed, scaled);
-  for (const landmarks::Landmark& given : landmarks.landmarks) {
-    for (const atlas::Landmark& landmark : scaled.atlas.landmarks) {
-      if (landmark.name == given.name) {
-        scaled.landmark_residual_mm[given.name] = (landmark.position - given.position_mm).norm();
-      }
-    }
-  }
-  scaled.atlas.provenance.push_back(
-      "scaled by mmm scale_atlas onto " + std::to_string(landmarks.landmarks.size()) +
-      " landmarks (" + (landmarks.source.empty() ? "unknown source" : landmarks.source) +
-      ", frame " + landmarks.frame + ")");
   scaled.timings.elements_s = seconds_since(stage);
-  scaled.timings.total_s = seconds_since(start);
-  return scaled;
 }
 
 nlohmann::json scaling_report_json(const ScaledAtlas& scaled) {

@@ -136,6 +136,22 @@ struct ScaledAtlas {
 ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::LandmarkSet& landmarks,
                         const AtlasScalingOptions& options = {});
 
+// The placed full surfaces and affine parts (atlas -> patient) of every bone.
+struct BonePlacement {
+  std::map<std::string, Eigen::MatrixX3d> vertices;  // bone -> full-level vertices
+  std::map<std::string, Eigen::Affine3d> affine;     // bone -> affine part of its placement
+};
+
+// Everything that follows the bones, given where they are: their coarser
+// levels, cartilages and ligaments, the muscles (blend, detail, attachment,
+// non-penetration) and every derived element. Fills `scaled`'s meshes,
+// muscles and atlas and adds to its timings; `scaled.bones` is left to the
+// caller (scale_atlas fills it, a later fit of the bones keeps its own).
+// Throws InvalidInputError for a bone without a placement or with a vertex
+// count other than its full mesh's, SolverError from a muscle solve.
+void carry_atlas(const PreparedAtlas& prepared, const BonePlacement& placed,
+                 const AtlasScalingOptions& options, ScaledAtlas& scaled);
+
 // The report people read (residuals, per-segment factors, muscles, timings).
 nlohmann::json scaling_report_json(const ScaledAtlas& scaled);
 

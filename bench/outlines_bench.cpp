@@ -1,0 +1,276 @@
+// Outline fitting: accuracy of the patient's bones after fitting their
+// outlines on the radiographs, beside landmark-only scaling, on patients the
+// atlas cannot represent exactly — another person's bones (gait2392's,
+// `mmm patient foreign`) and the atlas with local shape (torsion, bowing,
+// bumps: `mmm patient synth --local-shape`) — and the time of the fit.
+//
+// Patients are made once under $MMM_BENCH_OUT_DIR/outline_patients (reused
+// when present). Landmarks: the station's (femoral head, patella, ankle
+// centres) at their true positions, so that what remains is the shape.
+// Table on stdout and in outlines.accuracy.{txt,json} (bench/table.py folds
+// it into build/bench/outlines.json).
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "bench/bench_main.h"
+#include "core/atlas/atlas_io.h"
+#include "core/atlas/atlas_meshes.h"
+#include "core/atlas/bone_set_patient.h"
+#include "core/atlas/foreign_bones.h"
+#include "core/atlas/synthetic_patient.h"
+#include "core/image/radiograph_pair.h"
+#include "core/mesh/io/mesh_io.h"
+#include "core/mesh/surface_distance.h"
+#include "core/outlines/atlas_outline_fit.h"
+#include "core/scaling/atlas_scaling.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using mmm::landmarks::LandmarkSet;
+namespace scaling = mmm::scaling;
+namespace outlines = mmm::outlines;
+
+fs::path atlas_dir() {
+  const char* dir = std::getenv("MMM_BENCH_ATLAS");
+  return dir != nullptr ? dir : "build/atlas/vhf_right_leg";
+}
+fs::path out_dir() {
+  const char* dir = std::getenv("MMM_BENCH_OUT_DIR");
+  return dir != nullptr ? dir : "build/bench";
+}
+
+const std::vector<std::string> kMeasured = {"femur_r", "tibia_r", "patella_r", "pelvis"};
+const std::vector<std::string> kStation = {"femoral_head_centre_r", "patella_centre_r",
+                                           "ankle_centre_r"};
+
+struct Patient {
+  std::string name;
+  std::string kind;  // "foreign bones" | "local shape"
+  fs::path dir;
+  std::map<std::string, mmm::mesh::IndexedMesh> truth;  // measured bones
+  LandmarkSet landmarks;
+};
+
+LandmarkSet station_landmarks(const nlohmann::json& truth) {
+  LandmarkSet set;
+  set.source = "ground truth";
+  for (const std::string& name : kStation) {
+    const auto& p = truth.at("landmarks").at(name).at("position_mm");
+    set.landmarks.push_back(
+        {name,
+         Eigen::Vector3d(p[0].get<double>(), p[1].get<double>(), p[2].get<double>()),
+         {},
+         {}});
+  }
+  return set;
+}
+
+Patient make_patient(const std::string& kind, std::uint64_t seed) {
+  Patient patient;
+  patient.kind = kind;
+  const bool foreign = kind == "foreign bones";
+  patient.name = (foreign ? "foreign_" : "local_") + std::to_string(seed);
+  patient.dir = out_dir() / "outline_patients" / patient.name;
+  if (!fs::exists(patient.dir / "ground_truth.json")) {
+    if (foreign) {
+      mmm::atlas::ForeignBoneOptions options;
+      options.deformation.seed = seed;
+      options.deformation.local_shape = seed % 2 == 0;  // every other one with local shape too
+      const mmm::atlas::BoneSet set =
+          mmm::atlas::gait2392_bone_set(atlas_dir(), MMM_DATA_DIR, options);
+      mmm::atlas::PatientRadiographOptions pictures;
+      pictures.seed = seed;
+      mmm::atlas::make_bone_set_patient(set, atlas_dir(), patient.dir, pictures);
+    } else {
+      mmm::atlas::SyntheticPatientOptions options;
+      options.deformation.seed = seed;
+      options.deformation.local_shape = true;
+      mmm::atlas::make_synthetic_patient(atlas_dir(), patient.dir, options);
+    }
+  }
+  std::ifstream in(patient.dir / "ground_truth.json");
+  const nlohmann::json truth = nlohmann::json::parse(in);
+  patient.landmarks = station_landmarks(truth);
+  for (const std::string& bone : kMeasured) {
+    patient.truth[bone] =
+        mmm::mesh::read_mesh(foreign ? patient.dir / "bones" / (bone + ".ply")
+                                     : patient.dir / "atlas" / "meshes" / bone / "full.ply");
+  }
+  return patient;
+}
+
+struct Row {
+  std::string patient;
+  std::string kind;
+  std::map<std::string, mmm::mesh::SurfaceDistance> scaled;
+  std::map<std::string, mmm::mesh::SurfaceDistance> fitted;
+  double fit_seconds = 0.0;
+  std::map<std::string, double> held;
+};
+
+std::vector<std::pair<std::string, std::uint64_t>> patient_list() {
+  std::vector<std::pair<std::string, std::uint64_t>> list;
+  for (std::uint64_t seed = 201; seed <= 206; ++seed) list.emplace_back("foreign bones", seed);
+  for (std::uint64_t seed = 301; seed <= 303; ++seed) list.emplace_back("local shape", seed);
+  if (const char* only = std::getenv("MMM_BENCH_OUTLINE_PATIENTS")) {
+    // e.g. "foreign_201,local_301"
+    std::vector<std::pair<std::string, std::uint64_t>> kept;
+    const std::string wanted = std::string(",") + only + ",";
+    for (const auto& [kind, seed] : list) {
+      const std::string name =
+          (kind == "foreign bones" ? "foreign_" : "local_") + std::to_string(seed);
+      if (wanted.find("," + name + ",") != std::string::npos) kept.emplace_back(kind, seed);
+    }
+    list = kept;
+  }
+  return list;
+}
+
+// The fit's options; MMM_BENCH_OUTLINE_OPTIONS ("spacing=10,smooth=2,...")
+// changes them, to study one setting.
+outlines::AtlasOutlineFitOptions fit_options() {
+  outlines::AtlasOutlineFitOptions options;
+  const char* text = std::getenv("MMM_BENCH_OUTLINE_OPTIONS");
+  if (text == nullptr) return options;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos) continue;
+    const std::string key = item.substr(0, eq);
+    const double value = std::stod(item.substr(eq + 1));
+    if (key == "spacing") options.fit.node_spacing_mm = value;
+    if (key == "smooth") options.fit.smoothness_weight = value;
+    if (key == "prior") options.fit.prior_weight = value;
+    if (key == "affine") options.fit.affine_weight = value;
+    if (key == "robust") options.fit.robust_mm = value;
+    if (key == "fall") options.fit.min_fall_factor = value;
+    if (key == "neighbours") options.fit.node_neighbours = static_cast<int>(value);
+    if (key == "joint") options.joint_pin = value;
+  }
+  return options;
+}
+
+struct Loaded {
+  mmm::atlas::Atlas atlas;
+  std::shared_ptr<const scaling::PreparedAtlas> prepared;
+};
+
+const Loaded& loaded() {
+  static const Loaded data = [] {
+    Loaded l;
+    l.atlas = mmm::atlas::read_atlas(atlas_dir());
+    l.prepared =
+        scaling::prepare_atlas(l.atlas, mmm::atlas::read_atlas_meshes(l.atlas, atlas_dir()));
+    return l;
+  }();
+  return data;
+}
+
+Row measure(const Patient& patient) {
+  const Loaded& l = loaded();
+  const scaling::ScaledAtlas scaled = scaling::scale_atlas(*l.prepared, patient.landmarks);
+  const mmm::image::RadiographPair pair =
+      mmm::image::load_radiograph_pair(patient.dir / "radiographs" / "views.json");
+  const auto start = std::chrono::steady_clock::now();
+  const outlines::AtlasOutlineFit fit = outlines::fit_atlas_outlines(
+      scaled.atlas, scaled.meshes, patient.landmarks, pair, {}, fit_options());
+  Row row;
+  row.patient = patient.name;
+  row.kind = patient.kind;
+  row.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const std::string& bone : kMeasured) {
+    row.scaled[bone] =
+        mmm::mesh::surface_distance(scaled.meshes.at(bone).at("full"), patient.truth.at(bone));
+    for (const outlines::BoneOutlineFit& b : fit.bones) {
+      if (b.bone != bone) continue;
+      mmm::mesh::IndexedMesh fitted{b.vertices, scaled.meshes.at(bone).at("full").F};
+      row.fitted[bone] = mmm::mesh::surface_distance(fitted, patient.truth.at(bone));
+      row.held[bone] = b.held_by_prior;
+      if (std::getenv("MMM_BENCH_OUTLINE_VERBOSE") != nullptr) {
+        std::cerr << patient.name << " " << bone << ": nodes " << b.nodes << ", iterations "
+                  << b.iterations << (b.converged ? " converged" : "") << ", moved "
+                  << b.moved_mean_mm << " / " << b.moved_max_mm << " mm, held " << b.held_by_prior;
+        for (const auto& v : b.views) {
+          std::cerr << " | " << v.view << " " << v.matched << "/" << v.contour_points << " "
+                    << v.start_mean_mm << " -> " << v.mean_mm << " (p95 " << v.p95_mm << ")";
+        }
+        std::cerr << "\n";
+      }
+    }
+  }
+  return row;
+}
+
+void write_accuracy_table() {
+  std::vector<Row> rows;
+  for (const auto& [kind, seed] : patient_list()) rows.push_back(measure(make_patient(kind, seed)));
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(2);
+  text << "Outline fitting vs landmark-only scaling (station landmarks, exact); surface distance "
+          "to the true bone, mean / p95 / max (mm)\n";
+  text << std::left << std::setw(13) << "patient" << std::setw(14) << "kind";
+  for (const std::string& bone : kMeasured) text << std::setw(36) << bone;
+  text << "fit s\n";
+  nlohmann::json json = nlohmann::json::array();
+  for (const Row& row : rows) {
+    text << std::left << std::setw(13) << row.patient << std::setw(14) << row.kind;
+    nlohmann::json entry = {
+        {"patient", row.patient}, {"kind", row.kind}, {"fit_seconds", row.fit_seconds}};
+    for (const std::string& bone : kMeasured) {
+      const auto& s = row.scaled.at(bone);
+      std::ostringstream cell;
+      cell << std::fixed << std::setprecision(2) << s.mean_mm;
+      if (row.fitted.contains(bone)) {
+        const auto& f = row.fitted.at(bone);
+        cell << " -> " << f.mean_mm << "/" << f.p95_mm << "/" << f.max_mm;
+        entry["bones"][bone] = {{"scaled_mean_mm", s.mean_mm},       {"scaled_p95_mm", s.p95_mm},
+                                {"scaled_max_mm", s.max_mm},         {"fitted_mean_mm", f.mean_mm},
+                                {"fitted_p95_mm", f.p95_mm},         {"fitted_max_mm", f.max_mm},
+                                {"held_by_prior", row.held.at(bone)}};
+      }
+      text << std::setw(36) << cell.str();
+    }
+    text << std::setprecision(1) << row.fit_seconds << std::setprecision(2) << "\n";
+    json.push_back(entry);
+  }
+  std::cout << text.str();
+  fs::create_directories(out_dir());
+  std::ofstream(out_dir() / "outlines.accuracy.txt") << text.str();
+  std::ofstream(out_dir() / "outlines.accuracy.json") << json.dump(2) << '\n';
+}
+
+void BM_FitWholeLeg(benchmark::State& state) {
+  const std::vector<std::pair<std::string, std::uint64_t>> list = patient_list();
+  const Patient patient = make_patient(list.front().first, list.front().second);
+  const Loaded& l = loaded();
+  const scaling::ScaledAtlas scaled = scaling::scale_atlas(*l.prepared, patient.landmarks);
+  const mmm::image::RadiographPair pair =
+      mmm::image::load_radiograph_pair(patient.dir / "radiographs" / "views.json");
+  const outlines::AtlasOutlineFitOptions options = fit_options();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(outlines::fit_atlas_outlines(scaled.atlas, scaled.meshes,
+                                                          patient.landmarks, pair, {}, options));
+  }
+}
+BENCHMARK(BM_FitWholeLeg)->Unit(benchmark::kSecond)->Iterations(1);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return mmm::bench::run_suite(argc, argv, "mmm_bench_outlines", write_accuracy_table);
+}

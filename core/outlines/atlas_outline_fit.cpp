@@ -1,0 +1,143 @@
+#include "core/outlines/atlas_outline_fit.h"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+
+#include "core/atlas/kinematic_chain.h"
+#include "core/errors.h"
+#include "core/parallel_for.h"
+
+namespace mmm::outlines {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+// The operator's landmarks on the bone, then its joint centres.
+std::vector<PinnedPoint> pins_of(const atlas::Atlas& atlas, const std::string& bone,
+                                 const landmarks::LandmarkSet& landmarks,
+                                 const AtlasOutlineFitOptions& options) {
+  std::vector<PinnedPoint> pins;
+  for (const landmarks::Landmark& given : landmarks.landmarks) {
+    const atlas::Landmark* landmark = atlas.find_landmark(given.name);
+    if (landmark == nullptr || landmark->bone != bone) continue;
+    pins.push_back(
+        {"landmark " + given.name, landmark->position, given.position_mm, options.landmark_pin});
+  }
+  for (const atlas::Joint& joint : atlas.joints) {
+    if (joint.type == atlas::JointType::kWeld) continue;
+    if (joint.child == bone) {
+      const Eigen::Vector3d centre = joint.child_frame.translation();
+      pins.push_back({"joint " + joint.name, centre, centre, options.joint_pin});
+    } else if (joint.parent == bone) {
+      const Eigen::Vector3d centre = joint.parent_frame.translation();
+      pins.push_back({"joint " + joint.name, centre, centre, options.joint_pin});
+    }
+  }
+  return pins;
+}
+
+}  // namespace
+
+AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::AtlasMeshes& meshes,
+                                   const landmarks::LandmarkSet& landmarks,
+                                   const image::RadiographPair& pair,
+                                   const std::vector<OutlineCorrection>& corrections,
+                                   const AtlasOutlineFitOptions& options) {
+  std::vector<std::string> atlas_bones;
+  for (const atlas::Bone& bone : atlas.bones) atlas_bones.push_back(bone.name);
+  std::vector<const atlas::Bone*> chosen;
+  for (const std::string& name : options.bones) {
+    const atlas::Bone* bone = atlas.find_bone(name);
+    if (bone == nullptr) {
+      throw InvalidInputError("outline fit: bone '" + name + "' is not in atlas " + atlas.name +
+                              "; hint: its bones are " + joined(atlas_bones));
+    }
+    chosen.push_back(bone);
+  }
+  const std::vector<image::RadiographView> views = pair.calibrated_views();
+  std::vector<std::string> view_names;
+  for (const image::RadiographView& view : views) view_names.push_back(view.name);
+  for (const OutlineCorrection& correction : corrections) {
+    if (std::ranges::find(options.bones, correction.bone) == options.bones.end()) {
+      throw InvalidInputError("outline fit: a correction names bone '" + correction.bone +
+                              "', which is not fitted; hint: the fitted bones are " +
+                              joined(options.bones));
+    }
+    if (std::ranges::find(view_names, correction.view) == view_names.end()) {
+      throw InvalidInputError("outline fit: a correction names view '" + correction.view +
+                              "'; hint: the views are " + joined(view_names));
+    }
+  }
+
+  AtlasOutlineFit result;
+  auto start = std::chrono::steady_clock::now();
+  // One edge image per view and distinct stage sigma.
+  std::vector<double> sigmas;
+  for (const OutlineFitStage& stage : options.fit.stages) {
+    if (std::ranges::find(sigmas, stage.sigma_px) == sigmas.end()) sigmas.push_back(stage.sigma_px);
+  }
+  std::vector<std::unique_ptr<EdgeImage>> images(views.size() * sigmas.size());
+  std::vector<image::GrayImage16> radiographs(views.size());
+  for (std::size_t v = 0; v < views.size(); ++v) radiographs[v] = pair.image(views[v].name);
+  parallel_for(images.size(), options.threads, [&](std::size_t k) {
+    images[k] =
+        std::make_unique<EdgeImage>(radiographs[k / sigmas.size()], sigmas[k % sigmas.size()]);
+  });
+  std::vector<FitView> fit_views(views.size());
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    fit_views[v].view = &views[v];
+    for (const OutlineFitStage& stage : options.fit.stages) {
+      const auto s =
+          static_cast<std::size_t>(std::ranges::find(sigmas, stage.sigma_px) - sigmas.begin());
+      fit_views[v].edges.push_back(images[v * sigmas.size() + s].get());
+    }
+  }
+  result.images_seconds = seconds_since(start);
+
+  start = std::chrono::steady_clock::now();
+  result.bones.resize(chosen.size());
+  // Largest bones first, so that two threads end together.
+  std::vector<std::size_t> order(chosen.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::ranges::sort(order, [&](std::size_t a, std::size_t b) {
+    return meshes.at(chosen[a]->name).at("full").V.rows() >
+           meshes.at(chosen[b]->name).at("full").V.rows();
+  });
+  parallel_for(order.size(), options.threads, [&](std::size_t k) {
+    const atlas::Bone& bone = *chosen[order[k]];
+    const auto& levels = meshes.at(bone.name);
+    BoneOutlineInput input;
+    input.bone = bone.name;
+    input.full = &levels.at("full");
+    input.work =
+        levels.contains(options.work_level) ? &levels.at(options.work_level) : &levels.at("full");
+    input.pins = pins_of(atlas, bone.name, landmarks, options);
+    for (const OutlineCorrection& correction : corrections) {
+      if (correction.bone != bone.name) continue;
+      const int view =
+          static_cast<int>(std::ranges::find(view_names, correction.view) - view_names.begin());
+      for (const Eigen::Vector2d& point : correction.points_px) {
+        input.corrections.push_back({view, point});
+      }
+    }
+    result.bones[order[k]] = fit_bone_outline(input, fit_views, options.fit);
+  });
+  result.fit_seconds = seconds_since(start);
+  for (const atlas::Bone& bone : atlas.bones) {
+    if (std::ranges::find(options.bones, bone.name) == options.bones.end()) {
+      result.not_fitted.push_back(bone.name);
+    }
+  }
+  return result;
+}
+
+}  // namespace mmm::outlines

@@ -1,0 +1,136 @@
+#include "core/outlines/edge_image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/errors.h"
+
+namespace mmm::outlines {
+namespace {
+
+// Separable Gaussian blur with the kernel cut at 3 sigma, edges clamped.
+image::FloatImage blurred(const image::GrayImage16& in, double sigma) {
+  const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma)));
+  std::vector<float> kernel(static_cast<std::size_t>(2 * radius + 1));
+  double total = 0.0;
+  for (int k = -radius; k <= radius; ++k) {
+    const double w = std::exp(-0.5 * k * k / (sigma * sigma));
+    kernel[static_cast<std::size_t>(k + radius)] = static_cast<float>(w);
+    total += w;
+  }
+  for (float& w : kernel) w = static_cast<float>(w / total);
+  const int w = in.width;
+  const int h = in.height;
+  image::FloatImage rows(w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      float sum = 0.0F;
+      for (int k = -radius; k <= radius; ++k) {
+        const int xx = std::clamp(x + k, 0, w - 1);
+        sum += kernel[static_cast<std::size_t>(k + radius)] * static_cast<float>(in.at(xx, y));
+      }
+      rows.at(x, y) = sum;
+    }
+  }
+  image::FloatImage out(w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      float sum = 0.0F;
+      for (int k = -radius; k <= radius; ++k) {
+        const int yy = std::clamp(y + k, 0, h - 1);
+        sum += kernel[static_cast<std::size_t>(k + radius)] * rows.at(x, yy);
+      }
+      out.at(x, y) = sum;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+EdgeImage::EdgeImage(const image::GrayImage16& radiograph, double sigma_px, double system_blur_px)
+    : sigma_px_(sigma_px), edge_shift_px_(kSqrtEdgeShift * std::hypot(sigma_px, system_blur_px)) {
+  if (radiograph.empty() || radiograph.pixels.size() != radiograph.sample_count()) {
+    throw InvalidInputError(
+        "edge image: the radiograph is empty or its pixels do not match its size");
+  }
+  if (!(sigma_px > 0.0 && sigma_px <= 20.0)) {
+    throw InvalidInputError("edge image: smoothing sigma must be in (0, 20] px, got " +
+                            std::to_string(sigma_px));
+  }
+  if (!(system_blur_px >= 0.0 && system_blur_px <= 20.0)) {
+    throw InvalidInputError("edge image: the system blur must be in [0, 20] px, got " +
+                            std::to_string(system_blur_px));
+  }
+  smoothed_ = blurred(radiograph, sigma_px);
+  // Median gradient magnitude over every 4th pixel of every 4th row.
+  std::vector<float> magnitudes;
+  for (int y = 1; y + 1 < smoothed_.height; y += 4) {
+    for (int x = 1; x + 1 < smoothed_.width; x += 4) {
+      const float gx = 0.5F * (smoothed_.at(x + 1, y) - smoothed_.at(x - 1, y));
+      const float gy = 0.5F * (smoothed_.at(x, y + 1) - smoothed_.at(x, y - 1));
+      magnitudes.push_back(std::sqrt(gx * gx + gy * gy));
+    }
+  }
+  if (!magnitudes.empty()) {
+    auto middle = magnitudes.begin() + static_cast<std::ptrdiff_t>(magnitudes.size() / 2);
+    std::nth_element(magnitudes.begin(), middle, magnitudes.end());
+    median_gradient_ = *middle;
+  }
+}
+
+double EdgeImage::sample(const Eigen::Vector2d& pixel) const {
+  // Pixel (i, j) has its centre at (i + 0.5, j + 0.5).
+  const double x = std::clamp(pixel.x() - 0.5, 0.0, smoothed_.width - 1.0);
+  const double y = std::clamp(pixel.y() - 0.5, 0.0, smoothed_.height - 1.0);
+  const int x0 = std::min(static_cast<int>(x), smoothed_.width - 2 < 0 ? 0 : smoothed_.width - 2);
+  const int y0 = std::min(static_cast<int>(y), smoothed_.height - 2 < 0 ? 0 : smoothed_.height - 2);
+  const int x1 = std::min(x0 + 1, smoothed_.width - 1);
+  const int y1 = std::min(y0 + 1, smoothed_.height - 1);
+  const double fx = x - x0;
+  const double fy = y - y0;
+  return (1 - fy) * ((1 - fx) * smoothed_.at(x0, y0) + fx * smoothed_.at(x1, y0)) +
+         fy * ((1 - fx) * smoothed_.at(x0, y1) + fx * smoothed_.at(x1, y1));
+}
+
+std::optional<EdgeImage::Edge> EdgeImage::edge_along(const Eigen::Vector2d& p,
+                                                     const Eigen::Vector2d& n, double reach_px,
+                                                     double min_fall) const {
+  if (!(p.x() >= 0 && p.y() >= 0 && p.x() <= width() && p.y() <= height())) return std::nullopt;
+  constexpr double kStep = 0.5;
+  const int steps = std::max(1, static_cast<int>(std::ceil(reach_px / kStep)));
+  std::vector<double> fall(static_cast<std::size_t>(2 * steps + 1));
+  for (int k = -steps; k <= steps; ++k) {
+    const double s = k * kStep;
+    fall[static_cast<std::size_t>(k + steps)] =
+        -(sample(p + (s + kStep) * n) - sample(p + (s - kStep) * n)) / (2 * kStep);
+  }
+  const double prior_sigma = std::max(reach_px / 2.0, 1.0);
+  std::optional<int> best;
+  double best_score = 0.0;
+  for (int k = -steps + 1; k <= steps - 1; ++k) {
+    const double f = fall[static_cast<std::size_t>(k + steps)];
+    if (f < min_fall) continue;
+    if (f < fall[static_cast<std::size_t>(k + steps - 1)] ||
+        f < fall[static_cast<std::size_t>(k + steps + 1)]) {
+      continue;  // not a local peak
+    }
+    const double s = k * kStep;
+    const double score = f * std::exp(-0.5 * s * s / (prior_sigma * prior_sigma));
+    if (score > best_score) {
+      best_score = score;
+      best = k;
+    }
+  }
+  if (!best) return std::nullopt;
+  const double a = fall[static_cast<std::size_t>(*best + steps - 1)];
+  const double b = fall[static_cast<std::size_t>(*best + steps)];
+  const double c = fall[static_cast<std::size_t>(*best + steps + 1)];
+  const double curvature = a - 2 * b + c;
+  const double shift = curvature < 0 ? std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5) : 0.0;
+  return Edge{(*best + shift) * kStep + edge_shift_px_, b};
+}
+
+}  // namespace mmm::outlines
