@@ -31,7 +31,10 @@
 #include "core/atlas/bone_set_patient.h"
 #include "core/atlas/foreign_bones.h"
 #include "core/atlas/synthetic_patient.h"
+#include "core/image/outline_overlay.h"
+#include "core/image/png.h"
 #include "core/image/radiograph_pair.h"
+#include "core/mesh/aabb_tree.h"
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/surface_distance.h"
 #include "core/outlines/atlas_outline_fit.h"
@@ -84,14 +87,18 @@ Patient make_patient(const std::string& kind, std::uint64_t seed) {
   patient.kind = kind;
   const bool foreign = kind == "foreign bones";
   patient.name = (foreign ? "foreign_" : "local_") + std::to_string(seed);
-  patient.dir = out_dir() / "outline_patients" / patient.name;
+  patient.dir =
+      out_dir() /
+      (std::getenv("MMM_BENCH_OUTLINE_BONES_ONLY") != nullptr ? "outline_patients_bones_only"
+                                                              : "outline_patients") /
+      patient.name;
   if (!fs::exists(patient.dir / "ground_truth.json")) {
     if (foreign) {
       mmm::atlas::ForeignBoneOptions options;
       options.deformation.seed = seed;
       options.deformation.local_shape = seed % 2 == 0;  // every other one with local shape too
-      const mmm::atlas::BoneSet set =
-          mmm::atlas::gait2392_bone_set(atlas_dir(), MMM_DATA_DIR, options);
+      mmm::atlas::BoneSet set = mmm::atlas::gait2392_bone_set(atlas_dir(), MMM_DATA_DIR, options);
+      if (std::getenv("MMM_BENCH_OUTLINE_BONES_ONLY") != nullptr) set.soft_tissue.clear();
       mmm::atlas::PatientRadiographOptions pictures;
       pictures.seed = seed;
       mmm::atlas::make_bone_set_patient(set, atlas_dir(), patient.dir, pictures);
@@ -161,6 +168,9 @@ outlines::AtlasOutlineFitOptions fit_options() {
     if (key == "fall") options.fit.min_fall_factor = value;
     if (key == "neighbours") options.fit.node_neighbours = static_cast<int>(value);
     if (key == "joint") options.joint_pin = value;
+    if (key == "nearness") options.fit.nearness = value;
+    if (key == "reach0") options.fit.stages[0].reach_mm = value;
+    if (key == "sigma0") options.fit.stages[0].sigma_px = value;
   }
   return options;
 }
@@ -193,6 +203,24 @@ Row measure(const Patient& patient) {
   row.patient = patient.name;
   row.kind = patient.kind;
   row.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (std::getenv("MMM_BENCH_OUTLINE_VERBOSE") != nullptr) {
+    std::vector<mmm::mesh::IndexedMesh> shown;
+    shown.reserve(2 * fit.bones.size() + kMeasured.size());
+    std::vector<mmm::image::OutlineItem> items;
+    for (const outlines::BoneOutlineFit& b : fit.bones) {
+      shown.push_back(scaled.meshes.at(b.bone).at("full"));
+      items.push_back({b.bone, &shown.back(), {255, 60, 60}});
+      shown.push_back({b.vertices, scaled.meshes.at(b.bone).at("full").F});
+      items.push_back({b.bone, &shown.back(), {60, 255, 60}});
+    }
+    for (const std::string& bone : kMeasured)
+      items.push_back({bone, &patient.truth.at(bone), {60, 120, 255}});
+    mmm::image::OverlayOptions overlay;
+    overlay.max_width = 3000;
+    overlay.line_width_px = 1.0;
+    mmm::image::write_png(mmm::image::outline_overlay_pair(pair, items, overlay),
+                          out_dir() / (patient.name + "_outlines.png"));
+  }
   for (const std::string& bone : kMeasured) {
     row.scaled[bone] =
         mmm::mesh::surface_distance(scaled.meshes.at(bone).at("full"), patient.truth.at(bone));
@@ -201,6 +229,22 @@ Row measure(const Patient& patient) {
       mmm::mesh::IndexedMesh fitted{b.vertices, scaled.meshes.at(bone).at("full").F};
       row.fitted[bone] = mmm::mesh::surface_distance(fitted, patient.truth.at(bone));
       row.held[bone] = b.held_by_prior;
+      if (std::getenv("MMM_BENCH_OUTLINE_VERBOSE") != nullptr) {
+        mmm::mesh::write_mesh(fitted, out_dir() / (patient.name + "_" + bone + "_fitted.ply"));
+        const mmm::mesh::AabbTree tree(fitted);
+        const Eigen::VectorXd d = mmm::mesh::distances_to_surface(patient.truth.at(bone).V, tree);
+        // Far truth vertices by height band.
+        std::map<int, std::pair<int, int>> bands;
+        for (Eigen::Index i = 0; i < d.size(); ++i) {
+          auto& band = bands[static_cast<int>(std::floor(patient.truth.at(bone).V(i, 2) / 20.0))];
+          ++band.second;
+          if (d[i] > 5.0) ++band.first;
+        }
+        std::cerr << "  " << bone << " far (>5 mm) by 20 mm band:";
+        for (const auto& [z, c] : bands)
+          std::cerr << " " << z * 20 << ":" << c.first << "/" << c.second;
+        std::cerr << "\n";
+      }
       if (std::getenv("MMM_BENCH_OUTLINE_VERBOSE") != nullptr) {
         std::cerr << patient.name << " " << bone << ": nodes " << b.nodes << ", iterations "
                   << b.iterations << (b.converged ? " converged" : "") << ", moved "

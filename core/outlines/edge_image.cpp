@@ -97,7 +97,7 @@ double EdgeImage::sample(const Eigen::Vector2d& pixel) const {
 
 std::optional<EdgeImage::Edge> EdgeImage::edge_along(const Eigen::Vector2d& p,
                                                      const Eigen::Vector2d& n, double reach_px,
-                                                     double min_fall) const {
+                                                     double min_fall, double nearness) const {
   if (!(p.x() >= 0 && p.y() >= 0 && p.x() <= width() && p.y() <= height())) return std::nullopt;
   constexpr double kStep = 0.5;
   const int steps = std::max(1, static_cast<int>(std::ceil(reach_px / kStep)));
@@ -107,7 +107,7 @@ std::optional<EdgeImage::Edge> EdgeImage::edge_along(const Eigen::Vector2d& p,
     fall[static_cast<std::size_t>(k + steps)] =
         -(sample(p + (s + kStep) * n) - sample(p + (s - kStep) * n)) / (2 * kStep);
   }
-  const double prior_sigma = std::max(reach_px / 2.0, 1.0);
+  const double prior_sigma = std::max(reach_px * nearness, 1.0);
   std::optional<int> best;
   double best_score = 0.0;
   for (int k = -steps + 1; k <= steps - 1; ++k) {

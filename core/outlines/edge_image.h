@@ -7,7 +7,7 @@
 // outward across a bone's edge the intensity falls. edge_along() reads the
 // profile f(s) = I(p + s n) for s in [-reach, reach] (pixels, step 0.5) and
 // returns the position of the steepest fall, -f'(s), weighted by a Gaussian
-// prior on s (sigma = reach / 2) so that of two edges the nearer wins; the
+// prior on s (sigma = nearness * reach) so that of two edges the nearer wins; the
 // peak is refined by a parabola through its neighbours. An edge is found when
 // the fall there is at least `min_fall` (image units per pixel).
 //
@@ -54,7 +54,8 @@ class EdgeImage {
   // The edge along the unit direction n through p (see the file comment);
   // nothing when p is outside the image or no fall reaches min_fall.
   [[nodiscard]] std::optional<Edge> edge_along(const Eigen::Vector2d& p, const Eigen::Vector2d& n,
-                                               double reach_px, double min_fall) const;
+                                               double reach_px, double min_fall,
+                                               double nearness = 0.5) const;
 
  private:
   image::FloatImage smoothed_;

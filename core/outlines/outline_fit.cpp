@@ -4,11 +4,11 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <numeric>
 #include <tuple>
-#include <cstdio>
-#include <cstdlib>
 
 #include "core/errors.h"
 #include "core/outlines/contour_points.h"
@@ -255,7 +255,7 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
           if (overridden) continue;
           const std::optional<EdgeImage::Edge> edge =
               edges.edge_along(point.pixel, point.outward, settings.reach_mm / spacing,
-                               options.min_fall_factor * edges.median_gradient());
+                               options.min_fall_factor * edges.median_gradient(), options.nearness);
           if (!edge) continue;
           const double residual_mm = std::abs(edge->offset_px) * spacing;
           residuals.push_back(residual_mm);
@@ -303,9 +303,12 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
         }
         stats.matched = static_cast<int>(residuals.size());
         if (std::getenv("MMM_DEBUG_FIT") != nullptr) {
-          std::fprintf(stderr, "%s stage %zu it %d view %zu: %zu/%zu matched, mean %.3f\n",
-                       input.bone.c_str(), stage, iteration, v, residuals.size(), contour.size(),
-                       residuals.empty() ? 0.0 : std::accumulate(residuals.begin(), residuals.end(), 0.0) / residuals.size());
+          std::fprintf(
+              stderr, "%s stage %zu it %d view %zu: %zu/%zu matched, mean %.3f\n",
+              input.bone.c_str(), stage, iteration, v, residuals.size(), contour.size(),
+              residuals.empty()
+                  ? 0.0
+                  : std::accumulate(residuals.begin(), residuals.end(), 0.0) / residuals.size());
         }
         double mean = 0.0;
         for (const double r : residuals) mean += r;
