@@ -3,6 +3,7 @@
 #include "nodes/build_hulls.h"
 #include "nodes/decimate_mesh.h"
 #include "nodes/decompose_fibres.h"
+#include "nodes/fit_bone_outlines.h"
 #include "nodes/fuse_motion.h"
 #include "nodes/import_markups.h"
 #include "nodes/landmark_report.h"
@@ -27,6 +28,7 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<ImportMarkups>();
   registry.add<StaticTrialLandmarks>();
   registry.add<ScaleAtlas>();
+  registry.add<FitBoneOutlines>();
   registry.add<FuseMotion>();
   registry.add<BuildHulls>();
   registry.add<WrapMuscles>();

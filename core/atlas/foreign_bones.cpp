@@ -73,9 +73,14 @@ BoneSet gait2392_bone_set(const std::filesystem::path& atlas_dir,
     Eigen::Affine3d frame = bone->frame;
     frame.linear() = frame.linear() * 1000.0;
     surface.V = mapped(frame, surface.V);
-    // The scale of the area ratio (the hip bones are open: no volume).
+    // The scale of the length ratio (the longest side of the oriented box):
+    // each bone as long as the atlas's, so that the joints meet as they do in
+    // the atlas; its widths and shape stay gait2392's.
     double scale = reference_scale;
-    if (foreign.refine) scale = std::sqrt(mesh::surface_area(target) / mesh::surface_area(surface));
+    if (foreign.refine) {
+      scale = mesh::oriented_bounding_box(target).half_extents.maxCoeff() /
+              mesh::oriented_bounding_box(surface).half_extents.maxCoeff();
+    }
     if (std::string(foreign.bone) == "tibia_r") reference_scale = scale;
     const Eigen::Vector3d origin = bone->frame.translation();
     Eigen::Affine3d about = Eigen::Affine3d::Identity();

@@ -9,8 +9,10 @@
 // sacrum, femur_r, patella_r, tibia_r, fibula -> fibula_r, talus -> talus_r,
 // foot -> calcn_r (calcaneus and midfoot in one surface), bofoot -> toes_r):
 //  1. the body-frame surface (m) into the atlas by the atlas bone's frame
-//     (the gait2392 body frame the atlas was built with) and the scale of the
-//     volume ratio to the atlas bone;
+//     (the gait2392 body frame the atlas was built with), at the scale that
+//     makes it as long as the atlas bone (the longest side of the oriented
+//     bounding box), so that the joints meet as in the atlas; the foot bones
+//     take the tibia's scale;
 //  2. for the bones that are one bone in both (not the foot), a rigid
 //     iterative-closest-point refinement onto the atlas bone at that scale;
 //  3. the patient deformation of `deformation` (patient_deformation.h: the

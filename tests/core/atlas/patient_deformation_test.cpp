@@ -182,3 +182,46 @@ TEST(PatientDeformationTest, FemoralNeckTurnsByItsDrawnAngleAndTheHeadStaysInThe
 
 }  // namespace
 }  // namespace mmm::atlas
+
+namespace mmm::atlas {
+namespace {
+
+TEST(PatientDeformationTest, LocalShapeKeepsTheJointsAndEveryOtherFactor) {
+  const Atlas atlas = leg();
+  PatientOptions options = seeded(7);
+  const PatientDeformation plain = make_patient_deformation(atlas, options);
+  options.local_shape = true;
+  const PatientDeformation local = make_patient_deformation(atlas, options);
+  // The same proportions: local shape is drawn after everything else.
+  EXPECT_EQ(plain.factors.length, local.factors.length);
+  EXPECT_EQ(plain.factors.width, local.factors.width);
+  EXPECT_DOUBLE_EQ(plain.factors.neck_angle_deg, local.factors.neck_angle_deg);
+  ASSERT_FALSE(local.local.empty());
+  for (const auto& [bone, warp] : local.local) {
+    SCOPED_TRACE(bone);
+    EXPECT_TRUE(local.factors.torsion_deg.contains(bone));
+    // The joint centres at both ends are on the axis: they do not move.
+    const Eigen::Vector3d distal = warp.proximal + warp.length * warp.axis;
+    EXPECT_LT((warp.apply(warp.proximal) - warp.proximal).norm(), 1e-9);
+    EXPECT_LT((warp.apply(distal) - distal).norm(), 1e-9);
+    // Mid-shaft on the axis: moved by the bow alone.
+    const Eigen::Vector3d middle = warp.proximal + 0.5 * warp.length * warp.axis;
+    EXPECT_LT((warp.apply(middle) - middle - warp.bow).norm(), 1e-9);
+  }
+}
+
+TEST(PatientDeformationTest, TorsionTurnsTheDistalEndByItsAngle) {
+  LocalWarp warp;
+  warp.proximal = Eigen::Vector3d::Zero();
+  warp.axis = -Eigen::Vector3d::UnitZ();
+  warp.length = 400.0;
+  warp.torsion_rad = 0.2;
+  const Eigen::Vector3d lateral(30.0, 0.0, -400.0);
+  const Eigen::Vector3d turned = warp.apply(lateral);
+  EXPECT_NEAR(turned.z(), -400.0, 1e-9);
+  EXPECT_NEAR(std::atan2(turned.y(), turned.x()), -0.2, 1e-9);  // about -z: clockwise from above
+  EXPECT_NEAR(turned.head<2>().norm(), 30.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace mmm::atlas

@@ -1,0 +1,196 @@
+#include "nodes/fit_bone_outlines.h"
+
+#include <chrono>
+#include <string>
+
+#include "core/atlas/atlas_io.h"
+#include "core/atlas/atlas_meshes.h"
+#include "core/directory_bundle.h"
+#include "core/image/outline_overlay.h"
+#include "core/image/png.h"
+#include "core/image/radiograph_pair.h"
+#include "core/landmarks/landmark_set.h"
+#include "core/outlines/atlas_outline_fit.h"
+#include "core/scaling/atlas_scaling.h"
+#include "nodes/name_list.h"
+
+namespace mmm::nodes {
+namespace {
+
+std::string bone_list(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text;
+}
+
+outlines::AtlasOutlineFitOptions options_from(const workflow::NodeContext& context) {
+  outlines::AtlasOutlineFitOptions options;
+  options.bones = split_names(context.text("bones"));
+  options.work_level = context.text("work_level");
+  options.fit.node_spacing_mm = context.number("node_spacing_mm");
+  options.fit.smoothness_weight = context.number("smoothness_weight");
+  options.fit.robust_mm = context.number("robust_mm");
+  options.threads = static_cast<int>(context.integer("threads"));
+  return options;
+}
+
+nlohmann::json fit_report(const outlines::AtlasOutlineFit& fit) {
+  nlohmann::json bones = nlohmann::json::array();
+  for (const outlines::BoneOutlineFit& bone : fit.bones) {
+    nlohmann::json views = nlohmann::json::array();
+    for (const outlines::ViewFit& view : bone.views) {
+      views.push_back({{"view", view.view},
+                       {"contour_points", view.contour_points},
+                       {"matched", view.matched},
+                       {"start_mean_mm", view.start_mean_mm},
+                       {"mean_mm", view.mean_mm},
+                       {"p95_mm", view.p95_mm},
+                       {"corrections", view.corrections},
+                       {"correction_mean_mm", view.correction_mean_mm}});
+    }
+    nlohmann::json entry = {{"bone", bone.bone},
+                            {"converged", bone.converged},
+                            {"iterations", bone.iterations},
+                            {"nodes", bone.nodes},
+                            {"moved_mean_mm", bone.moved_mean_mm},
+                            {"moved_max_mm", bone.moved_max_mm},
+                            {"held_by_prior", bone.held_by_prior},
+                            {"views", views},
+                            {"pin_residual_mm", bone.pin_residual_mm}};
+    // Where the images do not decide the shape, the scaled atlas's holds.
+    if (bone.held_by_prior > 0.25) {
+      entry["note"] = "the images determine little of this bone (" +
+                      std::to_string(static_cast<int>(100 * bone.held_by_prior + 0.5)) +
+                      " % of its surface held by the prior: superimposed or seen edge-on)";
+    }
+    bones.push_back(entry);
+  }
+  return {{"format", "mmm-outline-fit"},
+          {"version", 1},
+          {"bones", bones},
+          {"not_fitted", fit.not_fitted},
+          {"images_seconds", fit.images_seconds},
+          {"fit_seconds", fit.fit_seconds}};
+}
+
+image::RgbImage8 overlay_picture(const atlas::Atlas& atlas, const atlas::AtlasMeshes& before,
+                                 const atlas::AtlasMeshes& after,
+                                 const outlines::AtlasOutlineFit& fit,
+                                 const image::RadiographPair& pair) {
+  std::vector<image::OutlineItem> items;
+  for (const outlines::BoneOutlineFit& bone : fit.bones) {
+    const atlas::Bone* b = atlas.find_bone(bone.bone);
+    const std::string level = b->meshes.size() > 1 ? b->meshes[1].level : "full";
+    items.push_back({bone.bone + " (scaled)", &before.at(bone.bone).at(level), {255, 70, 70}});
+    items.push_back({bone.bone + " (fitted)", &after.at(bone.bone).at(level), {70, 255, 90}});
+  }
+  image::OverlayOptions options;
+  options.legend = false;
+  return image::outline_overlay_pair(pair, items, options);
+}
+
+}  // namespace
+
+workflow::NodeSpec FitBoneOutlines::spec() {
+  using workflow::port::Atlas;
+  using workflow::port::File;
+  using workflow::port::LandmarkSet;
+  using workflow::port::RadiographPair;
+  using workflow::port::Report;
+  const outlines::AtlasOutlineFitOptions d;
+  return workflow::NodeSpec{
+      "fit_bone_outlines", 1,
+      "Fit the scaled bones to their outlines on both radiographs (silhouette-based 2D-3D "
+      "fit, the scaled shape as prior, the operator's landmarks held); muscles and every "
+      "derived element follow the bones"}
+      .input<Atlas>("atlas", "The scaled atlas (scale_atlas)")
+      .input<RadiographPair>("radiographs", "The patient's calibrated radiograph pair")
+      .optional_input<LandmarkSet>("landmarks", "The operator's landmarks, held in place")
+      .param<std::string>("bones", bone_list(d.bones),
+                          "Bones fitted (comma-separated); the others keep the scaled shape")
+      .param<std::string>("work_level", d.work_level,
+                          "Mesh level whose contours are matched (the full level is moved)")
+      .param<double>("node_spacing_mm", d.fit.node_spacing_mm,
+                     "Spacing of the deformation field's nodes", {.min = 2, .max = 50}, "mm")
+      .param<double>("smoothness_weight", d.fit.smoothness_weight,
+                     "Weight keeping neighbouring nodes' displacements alike",
+                     {.min = 1e-6, .max = 1e6})
+      .param<double>("robust_mm", d.fit.robust_mm,
+                     "Contour residuals beyond this count linearly (Huber)",
+                     {.min = 0.05, .max = 20}, "mm")
+      .param<std::int64_t>("threads", d.threads, "Worker threads", {.min = 1, .max = 64})
+      .output<Atlas>("atlas", "The patient's atlas with the bones fitted to the radiographs")
+      .output<Report>("report", "Per bone and view: contour residuals, movement, convergence")
+      .output<File>("overlay", "PNG: scaled (red) and fitted (green) outlines on the radiographs");
+}
+
+void FitBoneOutlines::run(workflow::NodeContext& context) {
+  const outlines::AtlasOutlineFitOptions options = options_from(context);
+  const auto started = std::chrono::steady_clock::now();
+  context.progress(0, 5, "reading the scaled atlas");
+  const std::filesystem::path in = context.scratch_dir() / "atlas_in";
+  unpack_directory(context.input_bytes("atlas"), in, "input 'atlas'");
+  atlas::Atlas scaled = atlas::read_atlas(in);
+  atlas::AtlasMeshes meshes = atlas::read_atlas_meshes(scaled, in, options.threads);
+  const image::RadiographPair pair = image::radiograph_pair_from_json_text(
+      context.input_bytes("radiographs"), "input 'radiographs'");
+  landmarks::LandmarkSet given;
+  if (context.has_input("landmarks")) {
+    given = landmarks::landmark_set_from_json_text(context.input_bytes("landmarks"),
+                                                   "input 'landmarks'");
+  }
+  context.progress(1, 5, "fitting the outlines");
+  const outlines::AtlasOutlineFit fit =
+      outlines::fit_atlas_outlines(scaled, meshes, given, pair, {}, options);
+  for (const outlines::BoneOutlineFit& bone : fit.bones) {
+    std::string line = bone.bone + ":";
+    for (const outlines::ViewFit& view : bone.views) {
+      line += " " + view.view + " " + std::to_string(view.start_mean_mm) + " -> " +
+              std::to_string(view.mean_mm) + " mm;";
+    }
+    context.info(line + (bone.converged ? " converged" : " not converged"));
+    if (!bone.converged) context.warn(bone.bone + ": the outline fit did not converge");
+  }
+  context.progress(2, 5, "carrying muscles and derived elements");
+  scaling::AtlasScalingOptions carry;
+  carry.threads = options.threads;
+  const auto prepared = scaling::prepare_atlas(scaled, meshes, carry);
+  scaling::BonePlacement placement;
+  for (const atlas::Bone& bone : scaled.bones) {
+    placement.vertices[bone.name] = meshes.at(bone.name).at("full").V;
+    placement.affine[bone.name] = Eigen::Affine3d::Identity();
+  }
+  for (const outlines::BoneOutlineFit& bone : fit.bones) {
+    placement.vertices[bone.bone] = bone.vertices;
+    Eigen::Affine3d affine = Eigen::Affine3d::Identity();
+    affine.linear() = bone.linear;
+    affine.translation() = bone.translation;
+    placement.affine[bone.bone] = affine;
+  }
+  scaling::ScaledAtlas carried;
+  scaling::carry_atlas(*prepared, placement, carry, carried);
+  carried.atlas.provenance.push_back(
+      "bones fitted to their outlines on the radiographs by mmm "
+      "fit_bone_outlines (" +
+      bone_list(options.bones) + ")");
+  context.progress(3, 5, "writing the patient's atlas");
+  const std::filesystem::path out = context.scratch_dir() / "atlas_out";
+  atlas::write_atlas_with_meshes(carried.atlas, carried.meshes, out, options.threads);
+  context.set_output("atlas", pack_directory(out));
+  nlohmann::json report = fit_report(fit);
+  nlohmann::json muscles = nlohmann::json::array();
+  for (const scaling::MuscleScaling& muscle : carried.muscles) {
+    muscles.push_back({{"muscle", muscle.muscle}, {"volume_ratio", muscle.solution.volume_ratio}});
+  }
+  report["muscles"] = muscles;
+  report["total_seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  context.set_output("report", report.dump(2));
+  context.progress(4, 5, "drawing the overlay");
+  const std::filesystem::path overlay = context.scratch_dir() / "overlay.png";
+  image::write_png(overlay_picture(scaled, meshes, carried.meshes, fit, pair), overlay);
+  context.set_output_file("overlay", overlay);
+  context.progress(5, 5, "done");
+}
+
+}  // namespace mmm::nodes
