@@ -82,8 +82,11 @@ std::string colour_text(image::Rgb8 colour) {
   return text.data();
 }
 
+// Divided, not multiplied, by the step count: the nearest double to the
+// rounded value, printed short ("412.3", not "412.30000000000001").
 double rounded_px(double value) {
-  return std::round(value / kOutlineResolutionPx) * kOutlineResolutionPx;
+  constexpr double kSteps = 1.0 / kOutlineResolutionPx;
+  return std::round(value * kSteps) / kSteps;
 }
 
 // Every bone's outline in every view, with its colour.
