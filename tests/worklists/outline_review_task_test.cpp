@@ -258,7 +258,7 @@ TEST_F(OutlineReviewTest, MalformedSubmissionsAreRejectedWithReasonsNeverThrown)
   too_many_in_all.back()["bone"] = "femur_r";
   const std::vector<std::pair<Json, std::string>> cases = {
       {Json::array(), "must be an object"},
-      {Json{{"decision", "maybe"}}, "'decision' must be \"accept\" or \"correct\""},
+      {Json{{"decision", "maybe"}}, R"('decision' must be "accept" or "correct")"},
       {Json::object(), "'decision' must be"},
       {Json{{"decision", "accept"}, {"extra", 1}}, "unknown field 'extra'"},
       {Json{{"decision", "accept"}, {"corrections", Json::array({good})}}, "must be empty"},
