@@ -107,9 +107,10 @@ Json bone_outlines(const image::RadiographPair& pair, const std::string& atlas_b
       levels += (levels.empty() ? "" : ", ") + mesh_level.level;
     }
     if (found == nullptr) {
-      throw InvalidInputError(std::string(kReviewWhat) + ": bone '" + bone.name +
-                              "' of the atlas has no mesh level '" + level +
-                              "'; hint: set the node's parameter 'level' to one of " + levels);
+      std::string message = std::string(kReviewWhat) + ": bone '" + bone.name;
+      message += "' of the atlas has no mesh level '" + level;
+      message += "'; hint: set the node's parameter 'level' to one of " + levels;
+      throw InvalidInputError(message);
     }
     const mesh::IndexedMesh surface = mesh::read_mesh(folder.path() / found->file);
     Json outlines = Json::object();
@@ -166,13 +167,15 @@ std::optional<image::OutlineCorrection> read_correction(const Json& entry, std::
                                                         std::vector<std::string>& reasons) {
   const std::string where = "corrections[" + std::to_string(index) + "]";
   if (!entry.is_object()) {
-    reasons.push_back(where + ": expected {\"bone\", \"view\", \"points\": [[u, v], ...]}");
+    reasons.push_back(where + R"(: expected {"bone", "view", "points": [[u, v], ...]})");
     return std::nullopt;
   }
   const std::size_t before = reasons.size();
   for (const auto& [key, value] : entry.items()) {
     if (key != "bone" && key != "view" && key != "points") {
-      reasons.push_back(where + ": unknown field '" + key + "'; the fields are bone, view, points");
+      std::string reason = where + ": unknown field '";
+      reason += key + "'; the fields are bone, view, points";
+      reasons.push_back(std::move(reason));
     }
   }
   image::OutlineCorrection correction;
@@ -351,7 +354,7 @@ workflow::ManualEvaluation evaluate_outline_review(const Json& request, const Js
       }
     }
   } else {
-    reasons.push_back("'decision' must be \"accept\" or \"correct\", got " + decision.dump());
+    reasons.push_back(R"('decision' must be "accept" or "correct", got )" + decision.dump());
   }
   if (!reasons.empty()) return evaluation;
   const Json radiographs = request.value("radiographs", Json());

@@ -44,11 +44,15 @@ class CorrectionsReader {
 
   void only_fields(const Json& object, const std::string& where,
                    std::initializer_list<const char*> known) const {
-    for (const auto& [key, value] : object.items()) {
+    for (auto it = object.begin(); it != object.end(); ++it) {
+      const std::string& key = it.key();
       if (std::ranges::none_of(known, [&](const char* name) { return key == name; })) {
-        std::string names;
-        for (const char* name : known) names += (names.empty() ? "" : ", ") + std::string(name);
-        fail(where, "unknown field '" + key + "'; hint: the fields are " + names);
+        std::string problem = "unknown field '" + key + "'; hint: the fields are ";
+        for (const char* name : known) {
+          if (problem.back() != ' ') problem += ", ";
+          problem += name;
+        }
+        fail(where, problem);
       }
     }
   }
@@ -123,7 +127,7 @@ class CorrectionsReader {
     } else if (decision == "correct") {
       out.decision = OutlineDecision::kCorrect;
     } else {
-      fail("decision", "must be \"accept\" or \"correct\", got \"" + decision + "\"");
+      fail("decision", R"(must be "accept" or "correct", got ")" + decision + "\"");
     }
     const Json& list = field(root, "", "corrections");
     if (!list.is_array()) fail("corrections", "must be a list, got " + short_json(list));
