@@ -1,22 +1,30 @@
-// An operator's landmark submission (the JSON of `mmm task submit --file` and
-// of the web API), evaluated against a task over a synthetic calibrated pair.
+// An operator's submission (the JSON of `mmm task submit --file` and of the
+// web API), evaluated the way the task actions do, through the task
+// behaviour every manual node type of mmm registers (workflow/manual_task.h),
+// against a task request over a synthetic calibrated pair: the landmark
+// station's and the outline review's, each input against both.
 #include <exception>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/bounded_json.h"
 #include "core/image/projection.h"
 #include "fuzz/fuzz_input.h"
 #include "fuzz/fuzz_targets.h"
-#include "worklists/landmark_task.h"
+#include "nodes/registry.h"
 
 namespace {
 
-mmm::worklists::Task make_task() {
+using Json = nlohmann::json;
+
+Json synthetic_views() {
   mmm::image::BiplanarOptions options;
   options.isocentre_mm = {0, 0, 500};
   options.detector_pixel_pitch_mm = 4.0;
-  nlohmann::json views = nlohmann::json::array();
+  Json views = Json::array();
   for (const mmm::image::RadiographView& view : mmm::image::make_biplanar_views(options)) {
-    nlohmann::json P = nlohmann::json::array();
+    Json P = Json::array();
     for (int r = 0; r < 3; ++r) {
       P.push_back({view.P(r, 0), view.P(r, 1), view.P(r, 2), view.P(r, 3)});
     }
@@ -26,20 +34,47 @@ mmm::worklists::Task make_task() {
                      {"pixel_spacing_mm", view.pixel_spacing_mm},
                      {"P", P}});
   }
-  mmm::worklists::Task task;
-  task.id = "0123456789";
-  task.node = "landmarks";
-  task.node_type = mmm::worklists::kLandmarkStationType;
-  task.request = {{"kind", "landmarks"},
-                  {"landmarks",
-                   {{{"name", "femoral_head_centre_r"}, {"required", true}},
-                    {{"name", "patella_centre_r"}, {"required", true}},
-                    {{"name", "ankle_centre_r"}, {"required", false}}}},
-                  {"views", views},
-                  {"reprojection_tolerance_mm", 3.0},
-                  {"side", "right"},
-                  {"review", false}};
-  return task;
+  return views;
+}
+
+// A request of each kind of task, as its node type's behaviour builds it.
+Json request_of_kind(const std::string& kind, const Json& views) {
+  if (kind == "landmarks") {
+    return {{"kind", "landmarks"},
+            {"landmarks",
+             {{{"name", "femoral_head_centre_r"}, {"required", true}},
+              {{"name", "patella_centre_r"}, {"required", true}},
+              {{"name", "ankle_centre_r"}, {"required", false}}}},
+            {"views", views},
+            {"reprojection_tolerance_mm", 3.0},
+            {"side", "right"},
+            {"review", false}};
+  }
+  const Json outline = {{{10.0, 10.0}, {20.0, 30.0}, {10.0, 10.0}}};
+  return {{"kind", kind},
+          {"views", views},
+          {"bones",
+           {{{"name", "femur_r"}, {"outlines", {{"frontal", outline}, {"lateral", outline}}}},
+            {{"name", "tibia_r"}, {"outlines", {{"frontal", outline}, {"lateral", outline}}}}}},
+          {"radiographs", std::string(64, 'a')},
+          {"atlas", std::string(64, 'b')},
+          {"review", false}};
+}
+
+struct Evaluator {
+  mmm::workflow::SubmissionFunction evaluate;
+  Json request;
+};
+
+std::vector<Evaluator> make_evaluators() {
+  static const mmm::workflow::NodeRegistry registry = mmm::nodes::make_node_registry();
+  const Json views = synthetic_views();
+  std::vector<Evaluator> evaluators;
+  for (const mmm::workflow::NodeType* type : registry.all()) {
+    if (!type->spec.is_manual()) continue;
+    evaluators.push_back({type->task.evaluate, request_of_kind(type->task.kind, views)});
+  }
+  return evaluators;
 }
 
 }  // namespace
@@ -47,11 +82,13 @@ mmm::worklists::Task make_task() {
 namespace mmm::fuzz {
 
 void submission(const std::uint8_t* data, std::size_t size) {
-  static const worklists::Task task = make_task();
-  try {
-    const nlohmann::json submission = parse_json(as_text(data, size));
-    (void)worklists::evaluate_landmark_submission(task, submission);
-  } catch (const std::exception&) {
+  static const std::vector<Evaluator> evaluators = make_evaluators();
+  for (const Evaluator& evaluator : evaluators) {
+    try {
+      const Json submission = parse_json(as_text(data, size));
+      (void)evaluator.evaluate(evaluator.request, submission);
+    } catch (const std::exception&) {
+    }
   }
 }
 

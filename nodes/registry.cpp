@@ -14,6 +14,7 @@
 #include "nodes/static_trial_landmarks.h"
 #include "nodes/wrap_muscles.h"
 #include "worklists/landmark_task.h"
+#include "worklists/outline_review_task.h"
 
 namespace mmm::nodes {
 
@@ -24,6 +25,7 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<MeasureMesh>();
   registry.add<LoadRadiographs>();
   registry.add<worklists::LandmarkStation>();
+  registry.add<worklists::OutlineReviewStation>();
   registry.add<LandmarkReport>();
   registry.add<ImportMarkups>();
   registry.add<StaticTrialLandmarks>();

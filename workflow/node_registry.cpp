@@ -7,12 +7,23 @@
 
 namespace mmm::workflow {
 
-void NodeRegistry::add(NodeSpec spec, RunFunction run) {
+void NodeRegistry::add(NodeSpec spec, RunFunction run, ManualTaskBehaviour task) {
   if (types_.contains(spec.name())) {
     throw InvalidInputError("node type '" + spec.name() + "' is registered twice");
   }
+  if (spec.is_manual() && !task.complete()) {
+    throw InvalidInputError(
+        "node type '" + spec.name() +
+        "' is manual but has no complete task behaviour (kind, request, evaluate, submission "
+        "fields); hint: register it with a ManualTaskBehaviour (workflow/manual_task.h)");
+  }
+  if (!spec.is_manual() && !task.empty()) {
+    throw InvalidInputError("node type '" + spec.name() +
+                            "' computes its result but was registered with a task behaviour; "
+                            "hint: only a manual node (NodeSpec::manual()) has tasks");
+  }
   std::string name = spec.name();
-  types_.emplace(std::move(name), NodeType{std::move(spec), std::move(run)});
+  types_.emplace(std::move(name), NodeType{std::move(spec), std::move(run), std::move(task)});
 }
 
 const NodeType* NodeRegistry::find(std::string_view name) const {

@@ -5,7 +5,7 @@
 namespace mmm::workflow {
 namespace {
 
-constexpr std::array<PortTypeInfo, 14> kPortTypes = {{
+constexpr std::array<PortTypeInfo, 15> kPortTypes = {{
     {PortType::kNumber, "Number", "A real number (JSON number text)", ".json"},
     {PortType::kInteger, "Integer", "A 64-bit integer (JSON number text)", ".json"},
     {PortType::kString, "String", "UTF-8 text (JSON string)", ".json"},
@@ -27,6 +27,10 @@ constexpr std::array<PortTypeInfo, 14> kPortTypes = {{
     {PortType::kMuscleFrames, "MuscleFrames", "Deformed muscle surfaces and action lines per frame",
      ".frames"},
     {PortType::kFibreSet, "FibreSet", "Muscle fibres as polylines (mm)", ".json"},
+    {PortType::kOutlineCorrections, "OutlineCorrections",
+     "An operator's verdict on bone outlines projected onto radiographs: accepted, or "
+     "corrected by edge points per bone and view (pixels), JSON",
+     ".json"},
 }};
 
 }  // namespace

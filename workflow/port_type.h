@@ -29,6 +29,8 @@ enum class PortType {
   kBonePoses,           // per-frame rigid pose of every bone
   kMuscleFrames,        // per-frame deformed muscle surfaces and action lines
   kFibreSet,            // muscle fibres as polylines
+  kOutlineCorrections,  // an operator's verdict on projected bone outlines, JSON
+                        // (core/image/outline_corrections.h)
 };
 
 struct PortTypeInfo {
@@ -76,6 +78,7 @@ using MarkerTrajectories = PortTag<PortType::kMarkerTrajectories>;
 using BonePoses = PortTag<PortType::kBonePoses>;
 using MuscleFrames = PortTag<PortType::kMuscleFrames>;
 using FibreSet = PortTag<PortType::kFibreSet>;
+using OutlineCorrections = PortTag<PortType::kOutlineCorrections>;
 }  // namespace port
 
 }  // namespace mmm::workflow

@@ -1,16 +1,15 @@
 #include "worklists/landmark_task.h"
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <array>
 #include <string>
 #include <vector>
 
-#include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/image/radiograph_pair.h"
 #include "core/landmarks/landmark_set.h"
 #include "core/landmarks/landmark_validation.h"
+#include "worklists/task_views.h"
 
 namespace mmm::worklists {
 namespace {
@@ -55,12 +54,7 @@ constexpr const char* kDefaultInstructions =
 std::string suffix(const std::string& side) { return side == "left" ? "_l" : "_r"; }
 
 const workflow::ParamValue& param(const workflow::CacheKeyParts& parts, const char* name) {
-  const auto it = parts.params.find(name);
-  if (it == parts.params.end()) {
-    throw InvalidInputError(std::string("landmark task: parameter '") + name +
-                            "' is missing from the node's key (made by an older mmm?)");
-  }
-  return it->second;
+  return key_param(parts, name, "landmark task");
 }
 
 landmarks::ValidationRules rules_of(const Json& request) {
@@ -91,23 +85,6 @@ landmarks::ValidationRules rules_of(const Json& request) {
   if (pelvis) rules.distances.push_back({"asis_r", "asis_l", 160.0, 340.0});
   rules.reprojection_tolerance_mm = request.at("reprojection_tolerance_mm").get<double>();
   return rules;
-}
-
-std::vector<image::RadiographView> views_of(const Json& request) {
-  std::vector<image::RadiographView> views;
-  for (const Json& entry : request.at("views")) {
-    image::RadiographView view;
-    view.name = entry.at("name").get<std::string>();
-    view.width = entry.at("width").get<int>();
-    view.height = entry.at("height").get<int>();
-    view.pixel_spacing_mm = entry.at("pixel_spacing_mm").get<double>();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c) view.P(r, c) = entry.at("P").at(r).at(c).get<double>();
-    }
-    view.source_mm = -view.P.leftCols<3>().inverse() * view.P.col(3);
-    views.push_back(view);
-  }
-  return views;
 }
 
 // The submission's pixels; every malformed part becomes a reason.
@@ -173,6 +150,15 @@ void LandmarkStation::run(workflow::NodeContext& /*context*/) {
       "worklist' lists its task, 'mmm task submit' or 'mmm serve' provide the landmarks");
 }
 
+workflow::ManualTaskBehaviour LandmarkStation::task_behaviour() {
+  workflow::ManualTaskBehaviour task;
+  task.kind = "landmarks";
+  task.request = landmark_task_request;
+  task.evaluate = evaluate_landmark_submission;
+  task.submission_fields = {"landmarks"};
+  return task;
+}
+
 Json landmark_task_request(const workflow::CacheKeyParts& parts,
                            const workflow::ArtifactStore& artifacts) {
   const auto input = parts.input_hashes.find("radiographs");
@@ -191,12 +177,7 @@ Json landmark_task_request(const workflow::CacheKeyParts& parts,
   request["reprojection_tolerance_mm"] =
       std::get<double>(param(parts, "reprojection_tolerance_mm"));
   request["radiographs"] = input->second;
-  request["patient"] = "";
-  if (const auto patient = parts.input_hashes.find("patient");
-      patient != parts.input_hashes.end()) {
-    const Json value = parse_json_or_discarded(artifacts.get(patient->second));
-    if (value.is_string()) request["patient"] = value.get<std::string>();
-  }
+  request["patient"] = optional_text_input(parts, artifacts, "patient");
   Json landmarks = Json::array();
   for (const LandmarkText& text : kLandmarks) {
     const std::string stem = text.stem;
@@ -214,34 +195,18 @@ Json landmark_task_request(const workflow::CacheKeyParts& parts,
     }
   }
   request["landmarks"] = landmarks;
-  Json views = Json::array();
-  Json images = Json::object();
-  for (const image::RadiographFile& file : pair.views) {
-    const image::RadiographView& view = file.view;
-    Json P = Json::array();
-    for (int r = 0; r < 3; ++r) {
-      P.push_back({view.P(r, 0), view.P(r, 1), view.P(r, 2), view.P(r, 3)});
-    }
-    const std::string sha = pair.image_sha256(view.name);
-    views.push_back({{"name", view.name},
-                     {"width", view.width},
-                     {"height", view.height},
-                     {"pixel_spacing_mm", view.pixel_spacing_mm},
-                     {"P", P},
-                     {"image_sha256", sha}});
-    images[view.name] = sha;
-  }
-  request["views"] = views;
-  request["images"] = images;
+  RequestViews views = request_views(pair);
+  request["views"] = std::move(views.views);
+  request["images"] = std::move(views.images);
   return request;
 }
 
-ManualEvaluation evaluate_landmark_submission(const Task& task, const Json& submission) {
+ManualEvaluation evaluate_landmark_submission(const Json& request, const Json& submission) {
   ManualEvaluation evaluation;
   const landmarks::PixelSubmission pixels = parse_submission(submission, evaluation.reasons);
-  const std::vector<image::RadiographView> views = views_of(task.request);
+  const std::vector<image::RadiographView> views = views_of_request(request);
   const landmarks::ValidationResult result =
-      landmarks::validate_submission(views, pixels, rules_of(task.request));
+      landmarks::validate_submission(views, pixels, rules_of(request));
   evaluation.reasons.insert(evaluation.reasons.end(), result.reasons.begin(), result.reasons.end());
   evaluation.values = Json::object();
   if (result.landmarks) evaluation.values = Json(*result.landmarks);

@@ -28,15 +28,16 @@
 // A submission gives each landmark's pixel position in each view:
 //   {"landmarks": {"femoral_head_centre_r": {"frontal": [u, v], "lateral": [u, v]}, ...}}
 // Anything malformed in it is a reason to reject, never an exception.
+// The node type carries this as its task behaviour (workflow/manual_task.h).
 
 #include <nlohmann/json.hpp>
 
+#include "workflow/manual_task.h"
 #include "workflow/node_context.h"
 #include "workflow/node_spec.h"
 #include "workflow/store/artifact_store.h"
 #include "workflow/study/cache_key.h"
 #include "worklists/manual_evaluation.h"
-#include "worklists/task.h"
 
 namespace mmm::worklists {
 
@@ -46,6 +47,8 @@ struct LandmarkStation {
   static workflow::NodeSpec spec();
   // Never called by the engine (the node is manual); throws to say so.
   static void run(workflow::NodeContext& context);
+  // Its tasks: landmark_task_request, evaluate_landmark_submission.
+  static workflow::ManualTaskBehaviour task_behaviour();
 };
 
 // The request of a task opened for a landmark_station node with these key
@@ -54,6 +57,7 @@ nlohmann::json landmark_task_request(const workflow::CacheKeyParts& parts,
                                      const workflow::ArtifactStore& artifacts);
 
 // Triangulates and validates a submission against the task's request.
-ManualEvaluation evaluate_landmark_submission(const Task& task, const nlohmann::json& submission);
+ManualEvaluation evaluate_landmark_submission(const nlohmann::json& request,
+                                              const nlohmann::json& submission);
 
 }  // namespace mmm::worklists

@@ -40,7 +40,7 @@ std::string task_state_names();
 struct Task {
   std::string id;         // 10 lowercase hex characters, unique across studies
   std::string node;       // the manual workflow node it belongs to
-  std::string node_type;  // e.g. "landmark_station"
+  std::string node_type;  // the manual node type: its task behaviour reads the request
   // The node's cache key (and its parts: parameters, input hashes) when the
   // task opened: a result is recorded under this key.
   std::string cache_key;
@@ -50,7 +50,7 @@ struct Task {
   std::string created_at;
   std::string updated_at;
   // What is needed, for the operator (names, images, instructions): the
-  // node type's own document (landmark_task.h for the station).
+  // node type's own document, built by its task behaviour (with "kind").
   nlohmann::json request = nlohmann::json::object();
   nlohmann::json submission;                   // the latest submission as given (null: none)
   nlohmann::json result;                       // the accepted values (null: none)

@@ -11,7 +11,7 @@
 #include "workflow/run/study_plan.h"
 #include "workflow/study/execution_records.h"
 #include "worklists/audit_trail.h"
-#include "worklists/landmark_task.h"
+#include "worklists/manual_evaluation.h"
 #include "worklists/task_store.h"
 
 namespace mmm::worklists {
@@ -92,11 +92,8 @@ std::string join(const std::vector<std::string>& reasons) {
   return text;
 }
 
-ManualEvaluation evaluate(const Task& task, const Json& submission) {
-  if (task.node_type == kLandmarkStationType) {
-    return evaluate_landmark_submission(task, submission);
-  }
-  throw TaskError("node type '" + task.node_type + "' has no manual task support in this mmm");
+ManualEvaluation evaluate(const Study& study, const Task& task, const Json& submission) {
+  return task_behaviour(study, task).evaluate(task.request, submission);
 }
 
 // Records the evaluated values as the manual node's result: an execution
@@ -209,6 +206,16 @@ SubmitOutcome accept_values(Study& study, Task& task, const Actor& actor,
 
 }  // namespace
 
+const workflow::ManualTaskBehaviour& task_behaviour(const Study& study, const Task& task) {
+  const workflow::NodeType* type = study.registry().find(task.node_type);
+  if (type == nullptr || !type->task.complete()) {
+    throw TaskError("task " + task.id + " belongs to node type '" + task.node_type +
+                    "', which this mmm does not know as a manual node; hint: 'mmm nodes' lists "
+                    "the node types (an mmm of the study's version handles the task)");
+  }
+  return type->task;
+}
+
 void check_operator_name(const std::string& name) {
   const bool valid =
       !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char c) {
@@ -271,8 +278,10 @@ std::vector<Task> open_waiting_tasks(Study& study, const Actor& actor) {
     task.key_parts = *node.key_parts;
     task.state = TaskState::kOpen;
     task.created_at = task.updated_at = workflow::utc_now_precise();
-    if (task.node_type == kLandmarkStationType) {
-      task.request = landmark_task_request(task.key_parts, study.artifacts());
+    const workflow::ManualTaskBehaviour& behaviour = node.type->task;
+    if (behaviour.request) {
+      task.request = behaviour.request(task.key_parts, study.artifacts());
+      task.request["kind"] = behaviour.kind;
     }
     insert_task(study.database(), task);
     audit(study, actor, task, "open", nullptr, task.request, "");
@@ -374,7 +383,7 @@ SubmitOutcome submit_task(Study& study, const std::string& id, const Actor& acto
       }
       require_operator(task, actor, "submit for");
     }
-    const ManualEvaluation evaluation = evaluate(task, submission);
+    const ManualEvaluation evaluation = evaluate(study, task, submission);
     audit(study, actor, task, "submit", task.result, submission, reason);
     if (!evaluation.reasons.empty()) {
       SubmitOutcome outcome;
@@ -428,7 +437,7 @@ SubmitOutcome accept_task(Study& study, const std::string& id, const Actor& acto
     const std::string submitter =
         correction ? task.pending_correction.value("by", "") : submitter_of(study, task);
     require_second_operator(submitter, task, actor);
-    const ManualEvaluation evaluation = evaluate(task, submission);
+    const ManualEvaluation evaluation = evaluate(study, task, submission);
     if (!evaluation.reasons.empty()) {
       throw TaskError("task " + task.id +
                       "'s submission no longer validates: " + join(evaluation.reasons));
@@ -472,7 +481,10 @@ Task reject_task(Study& study, const std::string& id, const Actor& actor,
 
 SubmitOutcome preview_submission(Study& study, const std::string& id, const Json& submission) {
   const Task task = load(study, id);
-  const ManualEvaluation evaluation = evaluate(task, submission);
+  const workflow::ManualTaskBehaviour& behaviour = task_behaviour(study, task);
+  const ManualEvaluation evaluation = behaviour.preview
+                                          ? behaviour.preview(task.request, submission)
+                                          : behaviour.evaluate(task.request, submission);
   SubmitOutcome outcome;
   outcome.task = task;
   outcome.reasons = evaluation.reasons;

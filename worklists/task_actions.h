@@ -81,10 +81,15 @@ struct SubmitOutcome {
   nlohmann::json values;             // what was computed from the submission (e.g. 3-D points)
 };
 
+// The task behaviour of the task's node type (workflow/manual_task.h):
+// what its request shows and how a submission is evaluated. Throws
+// TaskError when the study's registry has no manual node type of that name.
+const workflow::ManualTaskBehaviour& task_behaviour(const workflow::Study& study, const Task& task);
+
 // Submits values for a task the operator has claimed, or corrects an accepted
 // task (then a non-blank `reason` is required; with a review node the
 // correction awaits review and the accepted values stay in force). The
-// submission is validated by the node type (landmark_task.h).
+// submission is evaluated by the node type's task behaviour.
 SubmitOutcome submit_task(workflow::Study& study, const std::string& id, const Actor& actor,
                           const nlohmann::json& submission, const std::string& reason = {});
 

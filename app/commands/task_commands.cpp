@@ -176,7 +176,21 @@ Json read_submission(const TaskArgs& args) {
   return submission;
 }
 
+// An outline review's verdict (core/image/outline_corrections.h).
+void print_verdict(const Json& values) {
+  std::cout << "  decision " << values.value("decision", "") << '\n';
+  for (const Json& correction : values.value("corrections", Json::array())) {
+    std::cout << "  " << std::left << std::setw(16) << correction.value("bone", "") << std::setw(10)
+              << correction.value("view", "") << correction.value("points_px", Json::array()).size()
+              << " point(s)\n";
+  }
+}
+
 void print_values(const Json& values) {
+  if (values.is_object() && values.value("format", "") == "mmm-outline-corrections") {
+    print_verdict(values);
+    return;
+  }
   if (!values.is_object() || !values.contains("landmarks")) return;
   for (const Json& landmark : values["landmarks"]) {
     const Json& p = landmark["position_mm"];
@@ -251,6 +265,21 @@ void run_task_action(const std::string& action, const TaskArgs& args,
       }
       std::cout << "\n  " << task.request.value("instructions", "") << '\n';
     }
+    if (task.request.contains("bones")) {
+      std::cout << "  bones outlined (level " << task.request.value("level", "") << "):";
+      for (const Json& bone : task.request["bones"]) {
+        std::cout << ' ' << bone["name"].get<std::string>();
+      }
+      std::cout << "\n  views:";
+      for (const Json& view : task.request["views"]) {
+        std::cout << ' ' << view["name"].get<std::string>() << " (" << view["width"] << " x "
+                  << view["height"] << ")";
+      }
+      std::cout << "\n  " << task.request.value("instructions", "")
+                << "\n  submit {\"decision\": \"accept\"} or {\"decision\": \"correct\", "
+                   "\"corrections\": [{\"bone\", \"view\", \"points\": [[u, v], ...]}]} "
+                   "(--file; 'mmm task show ID --json' gives the outlines in pixels)\n";
+    }
     if (!task.rejection_reasons.empty()) {
       std::cout << "  last rejection:\n";
       for (const std::string& reason : task.rejection_reasons)
@@ -290,7 +319,7 @@ void run_task_action(const std::string& action, const TaskArgs& args,
       for (const std::string& reason : outcome.reasons) std::cerr << "  - " << reason << '\n';
       std::cerr << (outcome.correction
                         ? "the accepted values stay in force\n"
-                        : "the task is open again; claim it, fix the landmarks and submit\n");
+                        : "the task is open again; claim it, fix the submission and submit\n");
       set_exit_code(kExitFailed);
       return;
     }
@@ -376,6 +405,16 @@ void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registr
   worklist->callback([worklist_args] { run_worklist(*worklist_args); });
 
   auto* task = app.add_subcommand("task", "Work on one manual task (ID from 'mmm worklist')");
+  task->footer(
+      "Tasks by node type (see docs/operators.md):\n"
+      "  landmark_station  place landmarks in both views:\n"
+      "                    {\"landmarks\": {NAME: {VIEW: [u, v]}}} (or --point NAME:VIEW=U,V)\n"
+      "  outline_review    check the bones' outlines on the radiographs: {\"decision\": "
+      "\"accept\"}\n"
+      "                    or {\"decision\": \"correct\", \"corrections\": [{\"bone\": "
+      "\"femur_r\",\n"
+      "                    \"view\": \"frontal\", \"points\": [[u, v], ...]}]} (pixels on the "
+      "true edge)");
   task->require_subcommand(1);
   const auto add_action = [&](const std::string& name, const std::string& help,
                               bool needs_operator) {
@@ -412,11 +451,17 @@ void register_task_commands(CLI::App& app, const workflow::NodeRegistry& registr
   }
   {
     auto [command, args] = add_action(
-        "submit", "Submit landmark pixels; validated, then accepted or rejected with reasons",
+        "submit",
+        "Submit a task's values (landmark pixels, an outline verdict); validated, then accepted "
+        "or rejected with reasons",
         true);
-    command->add_option("--file", args->file,
-                        "Submission JSON: {\"landmarks\": {NAME: {VIEW: [u, v]}}}");
-    command->add_option("--point", args->points, "NAME:VIEW=U,V (pixels); repeatable");
+    command->add_option(
+        "--file", args->file,
+        "Submission JSON. Landmark station: {\"landmarks\": {NAME: {VIEW: [u, v]}}}. Outline "
+        "review: {\"decision\": \"accept\"} or {\"decision\": \"correct\", \"corrections\": "
+        "[{\"bone\": B, \"view\": V, \"points\": [[u, v], ...]}]} (pixels on the true edge)");
+    command->add_option("--point", args->points,
+                        "Landmark station: NAME:VIEW=U,V (pixels); repeatable");
     command->add_option("--reason", args->reasons, "Why: required to correct an accepted task");
     command->add_flag("--no-run", args->no_run, "Do not continue the study's run afterwards");
     command->add_option("--jobs,-j", args->jobs, "Nodes run at the same time when continuing")

@@ -13,6 +13,7 @@
 
 #include "core/errors.h"
 #include "core/image/mesh_render.h"
+#include "core/image/silhouette.h"
 
 namespace mmm::image {
 
@@ -303,87 +304,6 @@ class Painter {
   std::vector<std::size_t> touched_;
 };
 
-// Indices into V of the edges of the mesh's silhouette seen from `source`
-// (see the header), each once.
-std::vector<std::array<int, 2>> silhouette_edges(const mesh::IndexedMesh& surface,
-                                                 const Eigen::Vector3d& source) {
-  const Eigen::Index faces = surface.F.rows();
-  std::vector<int> side(static_cast<std::size_t>(faces));
-  for (Eigen::Index f = 0; f < faces; ++f) {
-    const Eigen::Vector3d a = surface.V.row(surface.F(f, 0)).transpose();
-    const Eigen::Vector3d b = surface.V.row(surface.F(f, 1)).transpose();
-    const Eigen::Vector3d c = surface.V.row(surface.F(f, 2)).transpose();
-    const double facing = (b - a).cross(c - a).dot((a + b + c) / 3.0 - source);
-    side[static_cast<std::size_t>(f)] = (facing > 0) - (facing < 0);
-  }
-  struct Corner {
-    int low = 0;
-    int high = 0;
-    int face = 0;
-  };
-  std::vector<Corner> corners;
-  corners.reserve(static_cast<std::size_t>(3 * faces));
-  for (Eigen::Index f = 0; f < faces; ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const int u = surface.F(f, k);
-      const int v = surface.F(f, (k + 1) % 3);
-      corners.push_back({std::min(u, v), std::max(u, v), static_cast<int>(f)});
-    }
-  }
-  std::ranges::sort(corners, [](const Corner& p, const Corner& q) {
-    return p.low != q.low ? p.low < q.low : p.high < q.high;
-  });
-  std::vector<std::array<int, 2>> edges;
-  for (std::size_t begin = 0; begin < corners.size();) {
-    std::size_t end = begin;
-    bool front = false;
-    bool back = false;
-    while (end < corners.size() && corners[end].low == corners[begin].low &&
-           corners[end].high == corners[begin].high) {
-      const int s = side[static_cast<std::size_t>(corners[end].face)];
-      front = front || s < 0;
-      back = back || s > 0;
-      ++end;
-    }
-    if (end - begin == 1 || (front && back)) {
-      edges.push_back({corners[begin].low, corners[begin].high});
-    }
-    begin = end;
-  }
-  return edges;
-}
-
-// The edges that belong to connected pieces (sharing vertices) of at least
-// `min_edges` edges, or to the largest pieces, in their input order.
-std::vector<std::array<int, 2>> drop_fragments(const std::vector<std::array<int, 2>>& edges,
-                                               int min_edges) {
-  if (min_edges <= 1 || edges.empty()) return edges;
-  // Union-find over the vertices the edges touch (path halving).
-  std::vector<int> vertices;
-  for (const auto& [a, b] : edges) vertices.insert(vertices.end(), {a, b});
-  std::ranges::sort(vertices);
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-  const auto slot = [&](int v) {
-    return static_cast<std::size_t>(std::ranges::lower_bound(vertices, v) - vertices.begin());
-  };
-  std::vector<std::size_t> parent(vertices.size());
-  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = i;
-  const auto root = [&](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
-  for (const auto& [a, b] : edges) parent[root(slot(a))] = root(slot(b));
-  std::vector<int> size(vertices.size(), 0);
-  for (const auto& edge : edges) ++size[root(slot(edge[0]))];
-  // The largest pieces are always kept: a box's whole outline has 4 to 6 edges.
-  const int threshold = std::min(min_edges, *std::ranges::max_element(size));
-  std::vector<std::array<int, 2>> kept;
-  for (const auto& edge : edges) {
-    if (size[root(slot(edge[0]))] >= threshold) kept.push_back(edge);
-  }
-  return kept;
-}
-
 // Projections (pixels) of the vertices used by faces; throws for a vertex on
 // or behind the source plane.
 std::vector<Eigen::Vector2d> project_vertices(const RadiographView& view,
@@ -438,7 +358,7 @@ void draw_view(const RadiographView& view, RgbImage8& canvas, std::span<const Ou
     const std::vector<Eigen::Vector2d> pixels =
         project_vertices(view, surface, item_label(items, k));
     const std::vector<std::array<int, 2>> edges =
-        drop_fragments(silhouette_edges(surface, view.source_mm), options.min_contour_edges);
+        keep_contour_pieces(silhouette_edges(surface, view.source_mm), options.min_contour_edges);
     for (const auto& [a, b] : edges) {
       painter.segment(pixels[static_cast<std::size_t>(a)], pixels[static_cast<std::size_t>(b)]);
     }

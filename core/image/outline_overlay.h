@@ -15,7 +15,8 @@
 //              (a boundary). Edges are found by sorting the 3 #F corner pairs.
 //              Connected pieces of fewer than min_contour_edges edges (noise
 //              of a coarse mesh turning edge-on) are dropped (union-find),
-//              the mesh's largest piece never.
+//              the mesh's largest piece never (silhouette.h: the same
+//              edges, also as chained polylines).
 //   lines:     each silhouette edge projected with the view's P and drawn
 //              anti-aliased: a pixel whose centre lies at distance d from the
 //              segment gets coverage clamp(w / 2 + 0.5 - d, 0, 1) (w the line

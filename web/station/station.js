@@ -1,5 +1,11 @@
-// mmm landmark station: the operator's page. Talks to the JSON API of
-// `mmm serve` (docs/operators.md: "Operator web UI and its JSON API").
+// mmm station: the operator's page. Talks to the JSON API of `mmm serve`
+// (docs/operators.md: "Operator web UI and its JSON API"). A task's request
+// says its "kind"; TASK_KINDS (at the end) maps each kind to the class that
+// shows it: LandmarkTask (place landmarks in both views) and
+// OutlineReviewTask (accept the bones' outlines or click their true edges).
+// Both have the same shape: views, mine, place(view, u, v), submission(),
+// complete(), preview(), showPreview(reasons, values), refresh(),
+// updateButtons(), drawOverlay(view, context), select(index), enter().
 //
 // Pixel convention (core/image/projection.h): u right, v down; pixel (i, j)
 // covers [i, i+1) x [j, j+1), so the image spans [0, width] x [0, height].
@@ -356,7 +362,7 @@
     pollTimer = null;
   }
 
-  class Station {
+  class LandmarkTask {
     constructor(task) {
       this.task = task;
       this.request = task.request;
@@ -375,6 +381,17 @@
     }
 
     get mine() { return this.task.state === "claimed" && this.task.assignee === operator; }
+
+    // Shows the landmark panel and its help.
+    enter() {
+      $("landmark-panel").hidden = false;
+      $("review-panel").hidden = true;
+      $("submit").textContent = "Submit";
+      $("help").textContent = "Click: place the selected landmark · wheel: zoom · drag: pan · " +
+        "right-drag: window/level · keys 1-9: select a landmark, F: fit both views";
+    }
+
+    get claimedText() { return "Claimed: place the landmarks."; }
 
     place(view, u, v) {
       if (!this.mine) {
@@ -470,6 +487,7 @@
       const state = this.task.state;
       $("claim").hidden = !(state === "open");
       $("release").hidden = !this.mine;
+      $("accept-outlines").hidden = true;
       $("submit").hidden = !this.mine;
       $("submit").disabled = !this.complete();
       $("task-state").innerHTML = `${chip(state)} ${this.task.assignee ? "assigned to " + escape(this.task.assignee) : "unassigned"}`;
@@ -515,6 +533,197 @@
     }
   }
 
+  // Distance from (u, v) to the segment a-b (pixels).
+  function segmentDistance(u, v, a, b) {
+    const du = b[0] - a[0], dv = b[1] - a[1];
+    const length2 = du * du + dv * dv;
+    const t = length2 > 0 ? Math.min(1, Math.max(0, ((u - a[0]) * du + (v - a[1]) * dv) / length2)) : 0;
+    return Math.hypot(u - (a[0] + t * du), v - (a[1] + t * dv));
+  }
+
+  // A click this far from every outline (screen pixels) picks no bone.
+  const PICK_RADIUS_PX = 60;
+
+  class OutlineReviewTask {
+    constructor(task) {
+      this.task = task;
+      this.request = task.request;
+      this.bones = this.request.bones || [];
+      this.colour = {};
+      for (const bone of this.bones) this.colour[bone.name] = bone.colour;
+      // Corrections in the order first made: "bone/view" -> {bone, view, points}.
+      this.corrections = new Map();
+      this.previewSeq = 0;
+      const given = task.submission && task.submission.corrections;
+      if (Array.isArray(given)) {
+        for (const c of given) {
+          if (c && Array.isArray(c.points)) {
+            this.corrections.set(`${c.bone}/${c.view}`, { bone: c.bone, view: c.view, points: c.points.slice() });
+          }
+        }
+      }
+      $("views").innerHTML = "";
+      this.views = (this.request.views || []).map((spec) => new View(spec, $("views"), this));
+    }
+
+    get mine() { return this.task.state === "claimed" && this.task.assignee === operator; }
+
+    enter() {
+      $("landmark-panel").hidden = true;
+      $("review-panel").hidden = false;
+      $("submit").textContent = "Submit corrections";
+      $("help").textContent = "Click near a bone's outline where its true edge is: a correction point for " +
+        "the nearest bone in that view · wheel: zoom · drag: pan · right-drag: window/level · F: fit both views";
+    }
+
+    get claimedText() { return "Claimed: accept the outlines, or click the true edges and submit corrections."; }
+
+    // The bone whose outline in `view` passes nearest to (u, v): {bone, distance} (pixels).
+    nearestBone(view, u, v) {
+      let best = null;
+      for (const bone of this.bones) {
+        for (const polyline of (bone.outlines && bone.outlines[view]) || []) {
+          for (let k = 1; k < polyline.length; k++) {
+            const distance = segmentDistance(u, v, polyline[k - 1], polyline[k]);
+            if (!best || distance < best.distance) best = { bone: bone.name, distance };
+          }
+        }
+      }
+      return best;
+    }
+
+    place(view, u, v) {
+      if (!this.mine) {
+        message("Claim the task to correct the outlines.", "bad");
+        return;
+      }
+      if (u < 0 || v < 0 || u > view.imageWidth || v > view.imageHeight) return;
+      const nearest = this.nearestBone(view.spec.name, u, v);
+      if (!nearest || nearest.distance * view.scale > PICK_RADIUS_PX) {
+        message("Click nearer to a bone's outline: the nearest outline picks the bone.", "bad");
+        return;
+      }
+      const key = `${nearest.bone}/${view.spec.name}`;
+      if (!this.corrections.has(key)) this.corrections.set(key, { bone: nearest.bone, view: view.spec.name, points: [] });
+      this.corrections.get(key).points.push([Math.round(u * 100) / 100, Math.round(v * 100) / 100]);
+      message("");
+      this.refresh();
+      this.preview();
+    }
+
+    remove(key, index) {
+      const correction = this.corrections.get(key);
+      if (!correction) return;
+      correction.points.splice(index, 1);
+      if (!correction.points.length) this.corrections.delete(key);
+      this.refresh();
+      this.preview();
+    }
+
+    select() {}
+
+    pointCount() {
+      let count = 0;
+      for (const c of this.corrections.values()) count += c.points.length;
+      return count;
+    }
+
+    submission() {
+      return {
+        decision: "correct",
+        corrections: [...this.corrections.values()].map((c) => ({ bone: c.bone, view: c.view, points: c.points })),
+      };
+    }
+
+    complete() { return this.pointCount() > 0; }
+
+    async preview() {
+      const seq = ++this.previewSeq;
+      if (!this.complete()) return this.showPreview([], null);
+      try {
+        const result = await api("POST", `/api/tasks/${this.task.id}/preview`, this.submission());
+        if (seq === this.previewSeq) this.showPreview(result.reasons, result.values);
+      } catch (error) {
+        if (seq === this.previewSeq) message(errorText(error), "bad");
+      }
+    }
+
+    showPreview(reasons) {
+      $("reasons").innerHTML = (reasons || []).map((r) => `<li>${escape(r)}</li>`).join("");
+      this.refresh();
+    }
+
+    refresh() {
+      const perBone = {};
+      for (const c of this.corrections.values()) perBone[c.bone] = (perBone[c.bone] || 0) + c.points.length;
+      $("bones").innerHTML = this.bones.map((b) =>
+        `<li data-bone="${escape(b.name)}"><span class="swatch" style="background:${escape(b.colour)}"></span>` +
+        `${escape(b.name)}<span class="count">${perBone[b.name] ? perBone[b.name] + " point(s)" : ""}</span></li>`).join("");
+      $("corrections").innerHTML = [...this.corrections.entries()].map(([key, c]) =>
+        `<li data-key="${escape(key)}" data-bone="${escape(c.bone)}" data-view="${escape(c.view)}">` +
+        `<span class="swatch" style="background:${escape(this.colour[c.bone] || "#fff")}"></span> ` +
+        `<strong>${escape(c.bone)}</strong> <span class="muted">in ${escape(c.view)}</span><div class="points">` +
+        c.points.map((p, i) => `<span class="point">${p[0].toFixed(1)}, ${p[1].toFixed(1)}` +
+          `<button class="remove" data-key="${escape(key)}" data-index="${i}" title="Remove this point">×</button></span>`).join("") +
+        `</div></li>`).join("");
+      $("corrections-empty").hidden = this.corrections.size > 0;
+      this.updateButtons();
+      for (const view of this.views) view.draw();
+    }
+
+    updateButtons() {
+      const state = this.task.state;
+      $("claim").hidden = !(state === "open");
+      $("release").hidden = !this.mine;
+      $("accept-outlines").hidden = !this.mine;
+      $("accept-outlines").disabled = this.complete();
+      $("accept-outlines").title = this.complete() ? "Remove the correction points to accept the outlines as they are" : "";
+      $("submit").hidden = !this.mine;
+      $("submit").disabled = !this.complete();
+      $("task-state").innerHTML = `${chip(state)} ${this.task.assignee ? "assigned to " + escape(this.task.assignee) : "unassigned"}`;
+    }
+
+    drawOverlay(view, context) {
+      const line = (points) => {
+        context.beginPath();
+        points.forEach(([u, v], k) => {
+          const [x, y] = view.toScreen(u, v);
+          if (k === 0) context.moveTo(x, y); else context.lineTo(x, y);
+        });
+        context.stroke();
+      };
+      context.save();
+      context.lineWidth = 1.5;
+      context.globalAlpha = 0.9;
+      for (const bone of this.bones) {
+        context.strokeStyle = bone.colour;
+        for (const polyline of (bone.outlines && bone.outlines[view.spec.name]) || []) line(polyline);
+      }
+      context.restore();
+      for (const c of this.corrections.values()) {
+        if (c.view !== view.spec.name) continue;
+        const colour = this.colour[c.bone] || "#fff";
+        context.save();
+        context.strokeStyle = colour;
+        context.setLineDash([6, 4]);
+        context.lineWidth = 2;
+        if (c.points.length > 1) line(c.points);
+        context.setLineDash([]);
+        for (const [u, v] of c.points) {
+          const [x, y] = view.toScreen(u, v);
+          context.fillStyle = colour;
+          context.strokeStyle = "#fff";
+          context.lineWidth = 1.5;
+          context.beginPath(); context.arc(x, y, 5, 0, 2 * Math.PI); context.fill(); context.stroke();
+        }
+        context.restore();
+      }
+    }
+  }
+
+  // The class that shows each kind of task (the request's "kind").
+  const TASK_KINDS = { landmarks: LandmarkTask, outline_review: OutlineReviewTask };
+
   function message(text, kind) {
     const node = $("task-message");
     node.textContent = text || "";
@@ -535,7 +744,15 @@
       message(errorText(error), "bad");
       return;
     }
-    station = new Station(task);
+    const Kind = TASK_KINDS[task.request.kind || "landmarks"];
+    if (!Kind) {
+      $("views").innerHTML = "";
+      station = null;
+      message(`This page cannot show tasks of kind '${task.request.kind}'; hint: mmm task show ${task.id}`, "bad");
+      return;
+    }
+    station = new Kind(task);
+    station.enter();
     window.mmmStation.station = station;
     $("task-title").textContent = `Task ${task.id}`;
     $("task-meta").textContent = `${task.patient} · study ${task.study} · node ${task.node} · opened ${task.age} ago`;
@@ -546,7 +763,7 @@
     }
     pollStudy(task.study);
     await Promise.all(station.views.map((view) => view.load(task.id).catch((error) => message(errorText(error), "bad"))));
-    if (Object.keys(station.points).length) station.preview();
+    station.preview();
   }
 
   async function reloadTask(text, kind) {
@@ -560,7 +777,7 @@
     if (!station) return;
     try {
       await api("POST", `/api/tasks/${station.task.id}/${action}`);
-      await reloadTask(action === "claim" ? "Claimed: place the landmarks." : "Released.", "ok");
+      await reloadTask(action === "claim" ? station.claimedText : "Released.", "ok");
     } catch (error) {
       message(errorText(error), "bad");
     }
@@ -568,11 +785,13 @@
   $("claim").addEventListener("click", () => act("claim"));
   $("release").addEventListener("click", () => act("release"));
 
-  $("submit").addEventListener("click", async () => {
+  // Submits values of the task shown; the outcome replaces its state.
+  async function submitValues(submission) {
     if (!station) return;
     $("submit").disabled = true;
+    $("accept-outlines").disabled = true;
     try {
-      const outcome = await api("POST", `/api/tasks/${station.task.id}/submit`, station.submission());
+      const outcome = await api("POST", `/api/tasks/${station.task.id}/submit`, submission);
       station.task = outcome.task;
       if (outcome.accepted) {
         message("Accepted: the study resumes.", "ok");
@@ -587,7 +806,9 @@
       message(errorText(error), "bad");
       station.updateButtons();
     }
-  });
+  }
+  $("submit").addEventListener("click", () => station && submitValues(station.submission()));
+  $("accept-outlines").addEventListener("click", () => submitValues({ decision: "accept" }));
 
   // The study's node states, every second while the task page is open.
   async function pollStudy(study, soon) {
@@ -622,6 +843,10 @@
   $("landmarks").addEventListener("click", (event) => {
     const item = event.target.closest("li[data-index]");
     if (item && station) station.select(Number(item.dataset.index));
+  });
+  $("corrections").addEventListener("click", (event) => {
+    const button = event.target.closest("button.remove");
+    if (button && station && station.remove) station.remove(button.dataset.key, Number(button.dataset.index));
   });
 
   // For tests and tools: where image point (u, v) of a view is on the page.

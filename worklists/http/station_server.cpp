@@ -336,19 +336,30 @@ struct StationServer::Impl {
     send_json(response, 200, {{"task", task_to_json(task)}});
   }
 
-  static Json submission_of(const Json& body) {
-    if (!body.contains("landmarks")) {
-      throw BadRequestError("the body has no \"landmarks\" object");
+  // The submission in a request body: the fields the task's node type
+  // takes (its task behaviour's submission fields), without the body's own
+  // ("reason").
+  static Json submission_of(const workflow::Study& study, const Task& task, const Json& body) {
+    const std::vector<std::string>& fields = task_behaviour(study, task).submission_fields;
+    Json submission = Json::object();
+    std::string names;
+    for (const std::string& field : fields) {
+      if (body.contains(field)) submission[field] = body[field];
+      names += (names.empty() ? "\"" : ", \"") + field + "\"";
     }
-    return {{"landmarks", body["landmarks"]}};
+    if (submission.empty()) {
+      throw BadRequestError("the body has none of the fields of a submission for task " + task.id +
+                            ": " + names);
+    }
+    return submission;
   }
 
   void preview(const std::string& id, const httplib::Request& request,
                httplib::Response& response) const {
     const WorklistEntry entry = locate(id);
     workflow::Study study = workflow::Study::open(entry.study_dir, registry);
-    const SubmitOutcome outcome =
-        preview_submission(study, entry.task.id, submission_of(parse_body(request)));
+    const SubmitOutcome outcome = preview_submission(
+        study, entry.task.id, submission_of(study, entry.task, parse_body(request)));
     send_json(response, 200, {{"reasons", outcome.reasons}, {"values", outcome.values}});
   }
 
@@ -357,8 +368,9 @@ struct StationServer::Impl {
     const WorklistEntry entry = locate(id);
     const Json body = parse_body(request);
     workflow::Study study = workflow::Study::open(entry.study_dir, registry);
-    const SubmitOutcome outcome = submit_task(study, entry.task.id, actor(name),
-                                              submission_of(body), body.value("reason", ""));
+    const SubmitOutcome outcome =
+        submit_task(study, entry.task.id, actor(name), submission_of(study, entry.task, body),
+                    body.value("reason", ""));
     Json json = outcome_json(outcome);
     json["study"] = entry.study;
     json["resuming"] = outcome.accepted;

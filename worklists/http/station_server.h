@@ -1,5 +1,5 @@
 #pragma once
-// The operator web UI of the landmark station (`mmm serve`): an HTTP server
+// The operator web UI of the manual tasks (`mmm serve`): an HTTP server
 // over the studies of a root folder. It serves the page (static files handed
 // in by the caller, e.g. embedded in the binary) and the JSON API the page
 // uses, documented in docs/operators.md ("Operator web UI and its JSON API"):
@@ -11,6 +11,8 @@
 //   POST /api/tasks/{id}/claim | release
 //   POST /api/tasks/{id}/preview           what a submission would give (reprojection errors)
 //   POST /api/tasks/{id}/submit            submit; accepted -> the study resumes at once
+//                                          (body: the submission's fields, those its node
+//                                          type's task behaviour names, plus "reason")
 //   GET  /api/studies/{study}/status       node states (plan_study), tasks, the runner
 //
 // Every /api/ request carries an operator token (`mmm operator add NAME`) as

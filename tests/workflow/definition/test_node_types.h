@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "tests/support/manual_task_stub.h"
 #include "tests/support/test_data.h"
 #include "workflow/node_registry.h"
 
@@ -42,7 +43,7 @@ inline NodeRegistry make_test_registry() {
                    .optional_input<port::LandmarkSet>("previous", "Landmarks to start from")
                    .output<port::LandmarkSet>("landmarks", "The landmarks")
                    .manual(),
-               nothing);
+               nothing, mmm::test::stub_task_behaviour());
   return registry;
 }
 

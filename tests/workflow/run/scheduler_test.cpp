@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "core/errors.h"
+#include "tests/support/manual_task_stub.h"
 #include "tests/support/test_data.h"
 #include "workflow/run/run_study.h"
 #include "workflow/run/study_plan.h"
@@ -80,11 +81,12 @@ NodeRegistry make_registry() {
                  }
                  context.set_output("out", text);
                });
-  registry.add(NodeSpec{"approve", 1, "A person confirms a number"}
-                   .input<port::Number>("in", "The number to confirm")
-                   .output<port::Number>("out", "The confirmed number")
-                   .manual(),
-               [](NodeContext&) {});
+  registry.add(
+      NodeSpec{"approve", 1, "A person confirms a number"}
+          .input<port::Number>("in", "The number to confirm")
+          .output<port::Number>("out", "The confirmed number")
+          .manual(),
+      [](NodeContext&) {}, mmm::test::stub_task_behaviour());
   return registry;
 }
 
