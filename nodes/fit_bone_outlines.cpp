@@ -6,6 +6,7 @@
 #include "core/atlas/atlas_io.h"
 #include "core/atlas/atlas_meshes.h"
 #include "core/directory_bundle.h"
+#include "core/image/outline_corrections.h"
 #include "core/image/outline_overlay.h"
 #include "core/image/png.h"
 #include "core/image/radiograph_pair.h"
@@ -106,6 +107,10 @@ workflow::NodeSpec FitBoneOutlines::spec() {
       .input<Atlas>("atlas", "The scaled atlas (scale_atlas)")
       .input<RadiographPair>("radiographs", "The patient's calibrated radiograph pair")
       .optional_input<LandmarkSet>("landmarks", "The operator's landmarks, held in place")
+      .optional_input<workflow::port::OutlineCorrections>(
+          "corrections",
+          "An operator's review of this atlas's outlines (outline_review): accepted, the atlas "
+          "passes through unchanged; corrected, the fit runs again with the operator's points")
       .param<std::string>("bones", bone_list(d.bones),
                           "Bones fitted (comma-separated); the others keep the scaled shape")
       .param<std::string>("work_level", d.work_level,
@@ -125,7 +130,7 @@ workflow::NodeSpec FitBoneOutlines::spec() {
 }
 
 void FitBoneOutlines::run(workflow::NodeContext& context) {
-  const outlines::AtlasOutlineFitOptions options = options_from(context);
+  outlines::AtlasOutlineFitOptions options = options_from(context);
   const auto started = std::chrono::steady_clock::now();
   context.progress(0, 5, "reading the scaled atlas");
   const std::filesystem::path in = context.scratch_dir() / "atlas_in";
@@ -139,9 +144,47 @@ void FitBoneOutlines::run(workflow::NodeContext& context) {
     given = landmarks::landmark_set_from_json_text(context.input_bytes("landmarks"),
                                                    "input 'landmarks'");
   }
+  // An operator's review: accepted as it is, or points to fit to.
+  std::vector<outlines::OutlineCorrection> corrections;
+  if (context.has_input("corrections")) {
+    const image::OutlineCorrections review =
+        image::read_outline_corrections(context.input_bytes("corrections"), "input 'corrections'");
+    if (review.decision == image::OutlineDecision::kAccept) {
+      context.info("the operator accepted the outlines as they are: the atlas passes through");
+      context.set_output("atlas", context.input_bytes("atlas"));
+      const nlohmann::json report = {{"format", "mmm-outline-fit"},
+                                     {"version", 1},
+                                     {"decision", "accept"},
+                                     {"bones", nlohmann::json::array()}};
+      context.set_output("report", report.dump(2));
+      const std::filesystem::path overlay = context.scratch_dir() / "overlay.png";
+      const outlines::AtlasOutlineFit none;
+      image::write_png(overlay_picture(scaled, meshes, meshes, none, pair), overlay);
+      context.set_output_file("overlay", overlay);
+      return;
+    }
+    for (const image::OutlineCorrection& c : review.corrections) {
+      corrections.push_back({c.bone, c.view, c.points_px});
+      // A bone the operator corrected is fitted, whether or not it was asked for.
+      if (std::ranges::find(options.bones, c.bone) == options.bones.end()) {
+        options.bones.push_back(c.bone);
+      }
+    }
+  }
+  // Bones of the list the atlas lacks (the default names the whole leg's)
+  // are left out, and said so.
+  std::vector<std::string> absent;
+  std::erase_if(options.bones, [&](const std::string& bone) {
+    const bool missing = scaled.find_bone(bone) == nullptr;
+    if (missing) absent.push_back(bone);
+    return missing;
+  });
+  if (!absent.empty()) {
+    context.warn("bones not in the atlas, not fitted: " + bone_list(absent));
+  }
   context.progress(1, 5, "fitting the outlines");
   const outlines::AtlasOutlineFit fit =
-      outlines::fit_atlas_outlines(scaled, meshes, given, pair, {}, options);
+      outlines::fit_atlas_outlines(scaled, meshes, given, pair, corrections, options);
   for (const outlines::BoneOutlineFit& bone : fit.bones) {
     std::string line = bone.bone + ":";
     for (const outlines::ViewFit& view : bone.views) {
@@ -178,6 +221,7 @@ void FitBoneOutlines::run(workflow::NodeContext& context) {
   atlas::write_atlas_with_meshes(carried.atlas, carried.meshes, out, options.threads);
   context.set_output("atlas", pack_directory(out));
   nlohmann::json report = fit_report(fit);
+  report["decision"] = corrections.empty() ? "fit" : "correct";
   nlohmann::json muscles = nlohmann::json::array();
   for (const scaling::MuscleScaling& muscle : carried.muscles) {
     muscles.push_back({{"muscle", muscle.muscle}, {"volume_ratio", muscle.solution.volume_ratio}});

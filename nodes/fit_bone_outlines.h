@@ -8,6 +8,12 @@
 //   input  atlas        Atlas           the scaled atlas (scale_atlas)
 //   input  radiographs  RadiographPair  the patient's calibrated pair
 //   input  landmarks    LandmarkSet     optional: the operator's landmarks, held
+//   input  corrections  OutlineCorrections  optional: an operator's review of the
+//                                       atlas's outlines (outline_review): "accept"
+//                                       passes the atlas through unchanged;
+//                                       "correct" fits again with the operator's
+//                                       points as strong terms (a corrected bone
+//                                       is fitted even when not in `bones`)
 //   output atlas        Atlas           the patient's atlas, bones fitted
 //   output report       Report          per bone and view: contour residual
 //                                       before/after (mm), matched share, how

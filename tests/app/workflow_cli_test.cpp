@@ -118,11 +118,11 @@ TEST(WorkflowCliTest, NodesJsonIsMachineReadable) {
               type["name"] == "landmark_station" || type["name"] == "outline_review")
         << type["name"];
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"build_hulls", "decimate_mesh", "decompose_fibres",
-                                             "fuse_motion", "import_markups", "landmark_report",
-                                             "landmark_station", "load_mesh", "load_radiographs",
-                                             "measure_mesh", "outline_review", "scale_atlas",
-                                             "static_trial_landmarks", "wrap_muscles"}))
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "build_hulls", "decimate_mesh", "decompose_fibres", "fit_bone_outlines",
+                       "fuse_motion", "import_markups", "landmark_report", "landmark_station",
+                       "load_mesh", "load_radiographs", "measure_mesh", "outline_review",
+                       "scale_atlas", "static_trial_landmarks", "wrap_muscles"}))
       << "sorted by name";
   const auto& decimate = json["node_types"][1];
   EXPECT_EQ(decimate["name"], "decimate_mesh");
