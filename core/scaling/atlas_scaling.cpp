@@ -239,7 +239,6 @@ void measure_stretch(BoneScaling& bone, const Eigen::Matrix3d& first_stage, cons
     }
   }
   if (local.empty()) return;
-  bone.local_points = static_cast<int>(local.centres.size());
   double lowest = 1.0;
   double highest = 1.0;
   Vector3d low_direction = Vector3d::UnitX();
@@ -369,7 +368,10 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
       report.solved = solution.solved;
       report.bent = solution.bent;
       report.free_directions = solution.free_directions;
-      for (const PointTerm& term : terms) report.terms.push_back(term.name);
+      for (const PointTerm& term : terms) {
+        report.terms.push_back(term.name);
+        if (term.falloff_radius_mm > 0.0) ++report.local_points;
+      }
       report.term_residual_mm = solution.residual_mm;
       measure_stretch(report, scaled.first_stage.deformation.bone_maps.at(bone->name).linear(),
                       solution.local, rest.V, options, scaled.warnings);

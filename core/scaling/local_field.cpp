@@ -70,18 +70,29 @@ LocalField fit_local_field(const std::vector<LocalPoint>& points) {
   }
   LocalField field;
   if (reach <= 0.0) return field;
-  // The conditions: every local point, and the pins within reach of one.
+  // The conditions: every local point, then the pins within reach of one
+  // (a pin within 1 mm of a condition already there, such as a landmark on a
+  // joint centre, adds nothing and would make the system singular).
   std::vector<const LocalPoint*> used;
   std::vector<double> radius;
   for (const LocalPoint& point : points) {
-    bool near = point.radius_mm > 0.0;
-    for (const LocalPoint& other : points) {
-      if (near) break;
-      near = other.radius_mm > 0.0 && (other.rest - point.rest).norm() < other.radius_mm;
-    }
-    if (!near) continue;
+    if (point.radius_mm <= 0.0) continue;
     used.push_back(&point);
-    radius.push_back(point.radius_mm > 0.0 ? point.radius_mm : reach);
+    radius.push_back(point.radius_mm);
+  }
+  const std::size_t local_count = used.size();
+  for (const LocalPoint& point : points) {
+    if (point.radius_mm > 0.0) continue;
+    bool near = false;
+    bool duplicate = false;
+    for (std::size_t k = 0; k < used.size(); ++k) {
+      const double distance = (used[k]->rest - point.rest).norm();
+      near = near || (k < local_count && distance < radius[k]);
+      duplicate = duplicate || distance < 1.0;
+    }
+    if (!near || duplicate) continue;
+    used.push_back(&point);
+    radius.push_back(reach);
   }
   const auto n = static_cast<Eigen::Index>(used.size());
   Eigen::MatrixXd Phi(n, n);

@@ -52,9 +52,9 @@ struct LocalPoint {
 };
 
 // Fits the field (see the file comment): a centre at every local point and
-// at every pinned point within the largest local radius of one (with that
-// radius). Empty when no point is local. Throws InvalidInputError for a
-// non-finite point, a negative radius or samples and weights of different
+// at every pinned point within the radius of one (with the largest local
+// radius) and more than 1 mm from the other centres. Empty when no point is local. Throws
+// InvalidInputError for a non-finite point, a negative radius or samples and weights of different
 // sizes, SolverError when two conditions coincide (the system is singular).
 LocalField fit_local_field(const std::vector<LocalPoint>& points);
 

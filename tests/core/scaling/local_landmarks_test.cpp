@@ -146,7 +146,9 @@ TEST(LocalLandmarksTest, ALocalEpicondyleWidensTheKneeNotTheHip) {
     largest = std::max(largest, moved);
   }
   EXPECT_LT(far_moved, 1e-6);
-  EXPECT_GT(near_moved, 3.0);
+  // The knee centre, 18 mm away, stays put (a pinned joint centre), so the
+  // surface beside the epicondyle moves a little less than its 4.2 mm.
+  EXPECT_GT(near_moved, 2.0);
 }
 
 }  // namespace
