@@ -143,10 +143,15 @@ BoneSolution solve_bone(const mesh::IndexedMesh& rest, const Eigen::Affine3d& pr
   }
   solution.residual_mm = residuals(terms, solution.vertices);
   solution.solved = true;
-  if (std::ranges::all_of(solution.residual_mm,
-                          [&](double r) { return r <= options.closed_form_tolerance_mm; })) {
-    return solution;
+  // A bend only for what the affine part misses: a local point's remaining
+  // residual (a welded bone's landmark, met on its own bone) is no reason to
+  // bend the whole surface.
+  bool missed = false;
+  for (std::size_t j = 0; j < terms.size(); ++j) {
+    missed = missed || (terms[j].falloff_radius_mm <= 0.0 &&
+                        solution.residual_mm[j] > options.closed_form_tolerance_mm);
   }
+  if (!missed) return solution;
 
   // 2. The detail: what no affine map explains, as a smooth bend d with
   //    the least change of the differential coordinates.

@@ -100,10 +100,20 @@ LocalField fit_local_field(const std::vector<LocalPoint>& points) {
   for (Eigen::Index j = 0; j < n; ++j) {
     const LocalPoint& point = *used[static_cast<std::size_t>(j)];
     if (point.radius_mm > 0.0) rhs.row(j) = point.misfit.transpose();
+    // Through the samples only when they stand for the point: a point off
+    // its surface (a landmark of a welded bone, anchored on the bone it
+    // moves with) extrapolates from far samples, whose field at the point's
+    // own centre then differs from 1 by more than 20 %; it is evaluated
+    // where it is.
+    double self = 0.0;
+    for (std::size_t i = 0; i < point.samples.size(); ++i) {
+      self += point.weights[i] * wendland_c2((point.samples[i] - point.rest).norm() / reach);
+    }
+    const bool near_samples = !point.samples.empty() && std::abs(self - 1.0) < 0.2;
     for (Eigen::Index k = 0; k < n; ++k) {
       const Eigen::Vector3d& centre = used[static_cast<std::size_t>(k)]->rest;
       const double R = radius[static_cast<std::size_t>(k)];
-      if (point.samples.empty()) {
+      if (!near_samples) {
         Phi(j, k) = wendland_c2((point.rest - centre).norm() / R);
         continue;
       }

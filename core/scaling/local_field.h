@@ -46,7 +46,9 @@ struct LocalPoint {
   Eigen::Vector3d rest = Eigen::Vector3d::Zero();    // p_j, rest frame (mm)
   Eigen::Vector3d misfit = Eigen::Vector3d::Zero();  // r_j (mm); ignored for pins
   double radius_mm = 0.0;                            // R_j > 0: local; 0: pinned
-  // d at the point is sum_i weights[i] d(samples[i]); empty: d(rest).
+  // d at the point is sum_i weights[i] d(samples[i]) when the samples stand
+  // for the point (their field of a centre at the point is 1 within 20 %);
+  // else (or empty) d(rest).
   std::vector<Eigen::Vector3d> samples;
   std::vector<double> weights;
 };

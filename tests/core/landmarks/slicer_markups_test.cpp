@@ -164,7 +164,7 @@ TEST(SlicerMarkupsTest, ErrorsNameTheFileAndJsonPath) {
   };
   const std::string path = (dir / "bad.mrk.json").string();
   EXPECT_THAT(error_for(R"({"markups": [{"type": "Fiducial", "controlPoints": [
-                  {"label": "a", "position": [1, 2, 3]}, {"label": "b", "position": [1, 2]}]}]})"),
+                  {"label": "ankle", "position": [1, 2, 3]}, {"label": "b", "position": [1, 2]}]}]})"),
               AllOf(HasSubstr(path + ": markups[0].controlPoints[1].position"),
                     HasSubstr("must be 3 finite numbers, got [1,2]")));
   EXPECT_THAT(error_for(R"({"markups": [{"type": "Fiducial", "coordinateSystem": "XYZ"}]})"),

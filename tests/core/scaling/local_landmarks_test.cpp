@@ -94,8 +94,10 @@ TEST(LocalLandmarksTest, AHeel40MmOffIsMetLocallyAndWarnedAbout) {
   landmarks::LandmarkSet set = mapped_landmarks(leg.atlas, patient_map(), kWithHeel);
   set.landmarks.back().position_mm += patient_map().linear() * Vector3d(0, -40, 0);
   const ScaledAtlas scaled = scale_atlas(*prepared, set);
-  // Met through the local field, exactly up to the anchors' rounding (1e-6 mm).
-  EXPECT_LT(scaled.landmark_residual_mm.at("heel_r"), 1e-6);
+  // Met through the local field: 0.01 mm, since on the toy's coarse talus
+  // (a 642-vertex ellipsoid) the heel's anchor spreads too far to stand for
+  // it and the field is fitted at the point itself (local_field.h).
+  EXPECT_LT(scaled.landmark_residual_mm.at("heel_r"), 0.01);
   ASSERT_FALSE(scaled.warnings.empty());
   const StretchWarning& warning = scaled.warnings.front();
   EXPECT_EQ(warning.bone, "talus_r");
