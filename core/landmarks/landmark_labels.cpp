@@ -152,7 +152,8 @@ std::vector<std::string> normalised_labels(const LandmarkLabels& entry) {
   for (const std::string& label : entry.labels) {
     const std::string stem = normalise_label(label);
     // Side-less leg labels mean the right leg; the ASIS need their side.
-    const bool sideless_ok = entry.side.empty() || (entry.side == "right" && entry.name != "asis_r");
+    const bool sideless_ok =
+        entry.side.empty() || (entry.side == "right" && entry.name != "asis_r");
     if (sideless_ok) out.insert(stem);
     for (const std::string& side : sides) {
       out.insert(side + stem);
