@@ -19,6 +19,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -35,6 +36,7 @@
 #include "core/opensim/trc.h"
 #include "core/parallel_for.h"
 #include "core/scaling/atlas_scaling.h"
+#include "core/scaling/local_field.h"
 
 namespace {
 
@@ -296,8 +298,19 @@ nlohmann::json real_data_check(std::ostream& out) {
           {"tibia_r", {{"ours", tibia}, {"opensim", 0.988523}, {"shank_mm", shank}}}};
 }
 
+void landmark_set_table(std::ostream& out, nlohmann::json& document);
+
 void accuracy_table(std::ostream& out) {
   const Loaded& l = loaded();
+  if (std::getenv("MMM_BENCH_SETS_ONLY") != nullptr) {
+    nlohmann::json document;
+    landmark_set_table(std::cout, document);  // as it goes: the runs take minutes
+    const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
+    std::ofstream file(std::filesystem::path(out_dir != nullptr ? out_dir : ".") /
+                       "scaling.landmark_sets.json");
+    file << document.dump(2) << "\n";
+    return;
+  }
   const int patients = std::getenv("MMM_BENCH_PATIENTS") != nullptr
                            ? std::atoi(std::getenv("MMM_BENCH_PATIENTS"))
                            : 10;
@@ -399,10 +412,158 @@ void accuracy_table(std::ostream& out) {
                              {"prepare_seconds", l.prepared->prepare_seconds},
                              {"prepare_anchors_seconds", l.prepared->anchors_seconds}};
   document["real_data"] = real_data_check(out);
+  landmark_set_table(out, document);
   const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
   std::ofstream file(std::filesystem::path(out_dir != nullptr ? out_dir : ".") /
                      "scaling.accuracy.json");
   file << document.dump(2) << "\n";
+}
+
+// Landmark sets and locality: per bone, the mean surface error for each
+// landmark set, over patients of two kinds: the synthetic patients as they
+// are (the atlas under one affine map per bone), and the same with local
+// shape variation — around every bony landmark its bone's surface (and the
+// landmark) displaced by a bump of 50 mm radius and a random 2.5 mm-per-axis
+// amplitude, so that e.g. the distal femur widens differently from the shaft.
+// Each kind is scaled twice: every landmark on the bone's affine part
+// ("one affine": local_radius_mm = 0, the design before local landmarks) and
+// with the atlas's local landmarks acting locally ("local").
+struct BoneTruth {
+  mmm::atlas::Atlas atlas;
+  std::map<std::string, mmm::mesh::IndexedMesh> bones;  // full levels
+};
+
+BoneTruth make_bone_truth(const Loaded& l, std::uint64_t seed, double height_mm, bool local) {
+  mmm::atlas::PatientOptions options;
+  options.seed = seed;
+  options.height_mm = height_mm;
+  const mmm::atlas::PatientDeformation deformation =
+      mmm::atlas::make_patient_deformation(l.atlas, options);
+  BoneTruth truth;
+  truth.atlas = mmm::atlas::deform_atlas(l.atlas, deformation);
+  for (const auto& bone : l.atlas.bones) {
+    truth.bones[bone.name] =
+        mmm::atlas::deform_bone_mesh(deformation, bone.name, l.meshes.at(bone.name).at("full"));
+  }
+  if (!local) return truth;
+  std::mt19937_64 random(seed * 7919U + 13U);
+  std::normal_distribution<double> amplitude(0.0, 2.5);
+  for (const std::string& name : bony_landmarks()) {
+    mmm::atlas::Landmark* landmark = nullptr;
+    for (auto& candidate : truth.atlas.landmarks) {
+      if (candidate.name == name) landmark = &candidate;
+    }
+    if (landmark == nullptr) continue;
+    const Eigen::Vector3d centre = landmark->position;
+    const Eigen::Vector3d delta(amplitude(random), amplitude(random), amplitude(random));
+    Eigen::MatrixX3d& V = truth.bones.at(landmark->bone).V;
+    for (Eigen::Index i = 0; i < V.rows(); ++i) {
+      const double r = (Eigen::Vector3d(V.row(i).transpose()) - centre).norm() / 50.0;
+      V.row(i) += scaling::wendland_c2(r) * delta.transpose();
+    }
+    landmark->position += delta;
+  }
+  return truth;
+}
+
+void landmark_set_table(std::ostream& out, nlohmann::json& document) {
+  const Loaded& l = loaded();
+  const int patients = std::getenv("MMM_BENCH_PATIENTS") != nullptr
+                           ? std::atoi(std::getenv("MMM_BENCH_PATIENTS"))
+                           : 10;
+  const auto plus = [](std::vector<std::string> names, const std::vector<std::string>& more) {
+    names.insert(names.end(), more.begin(), more.end());
+    return names;
+  };
+  const std::vector<std::pair<std::string, std::vector<std::string>>> sets = {
+      {"station", kStation},
+      {"+ASIS", plus(kStation, {"asis_r", "asis_l"})},
+      {"+epicondyles", plus(kStation, {"lateral_epicondyle_r", "medial_epicondyle_r"})},
+      {"+malleoli", plus(kStation, {"lateral_malleolus_r", "medial_malleolus_r"})},
+      {"+heel", plus(kStation, {"heel_r"})},
+      {"+8 bony", plus(kStation, kBony)}};
+  // Subset -> superset pairs whose per-bone error must not rise.
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t s = 1; s < sets.size(); ++s) pairs.emplace_back(0, s);
+  for (std::size_t s = 1; s + 1 < sets.size(); ++s) pairs.emplace_back(s, sets.size() - 1);
+  nlohmann::json tables = nlohmann::json::object();
+  // $MMM_BENCH_SET_VARIANTS: which of the four to run (affine/local truth x
+  // one affine/local landmarks), e.g. "al,ll"; default all four.
+  const std::string variants = std::getenv("MMM_BENCH_SET_VARIANTS") != nullptr
+                                   ? std::getenv("MMM_BENCH_SET_VARIANTS")
+                                   : "aa,al,la,ll";
+  for (const bool local_truth : {false, true}) {
+    for (const double radius : {0.0, scaling::AtlasScalingOptions{}.local_radius_mm}) {
+      const std::string code = std::string(local_truth ? "l" : "a") + (radius > 0.0 ? "l" : "a");
+      if (variants.find(code) == std::string::npos) continue;
+      scaling::AtlasScalingOptions options;
+      options.local_radius_mm = radius;
+      options.muscle.max_penetration_iterations = 0;  // bones only are measured here
+      // error[set][patient][bone]
+      std::vector<std::vector<std::map<std::string, double>>> error(sets.size());
+      for (int p = 0; p < patients; ++p) {
+        const std::uint64_t seed = 101 + static_cast<std::uint64_t>(p);
+        const double height = 1500.0 + 550.0 * p / std::max(1, patients - 1);
+        const BoneTruth truth = make_bone_truth(l, seed, height, local_truth);
+        for (std::size_t s = 0; s < sets.size(); ++s) {
+          const scaling::ScaledAtlas scaled =
+              scaling::scale_atlas(*l.prepared, landmark_set(truth.atlas, sets[s].second), options);
+          std::map<std::string, double> per_bone;
+          std::vector<double> mean(l.atlas.bones.size());
+          mmm::parallel_for(l.atlas.bones.size(), 2, [&](std::size_t b) {
+            const std::string& bone = l.atlas.bones[b].name;
+            mean[b] =
+                mmm::mesh::surface_distance(scaled.meshes.at(bone).at("full"), truth.bones.at(bone))
+                    .mean_mm;
+          });
+          for (std::size_t b = 0; b < mean.size(); ++b) per_bone[l.atlas.bones[b].name] = mean[b];
+          error[s].push_back(per_bone);
+        }
+      }
+      const std::string name = std::string(local_truth ? "local variation" : "affine patients") +
+                               ", " + (radius > 0.0 ? "local landmarks" : "one affine");
+      out << "\nper-bone mean surface distance (mm), " << name << ", median over " << patients
+          << " patients:\n"
+          << std::left << std::setw(14) << "set";
+      for (const auto& bone : l.atlas.bones) out << " " << std::setw(10) << bone.name;
+      out << "\n";
+      nlohmann::json table;
+      for (std::size_t s = 0; s < sets.size(); ++s) {
+        out << std::setw(14) << sets[s].first;
+        for (const auto& bone : l.atlas.bones) {
+          std::vector<double> values;
+          for (const auto& patient : error[s]) values.push_back(patient.at(bone.name));
+          out << " " << std::setw(10) << fixed(median(values), 2);
+          table["median"][sets[s].first][bone.name] = median(values);
+        }
+        out << "\n";
+      }
+      // The largest rise of any bone's error, over patients, per pair.
+      out << "largest rise of a bone's mean error when landmarks are added (any patient):\n";
+      for (const auto& [sub, super] : pairs) {
+        double rise = -1e9;
+        std::string where;
+        for (int p = 0; p < patients; ++p) {
+          for (const auto& bone : l.atlas.bones) {
+            const double d = error[super][static_cast<std::size_t>(p)].at(bone.name) -
+                             error[sub][static_cast<std::size_t>(p)].at(bone.name);
+            if (d > rise) {
+              rise = d;
+              where = bone.name + " (seed " + std::to_string(101 + p) + ")";
+            }
+          }
+        }
+        out << "  " << sets[sub].first << " -> " << sets[super].first << ": " << fixed(rise, 3)
+            << " mm, " << where << (rise > 0.2 ? "  ABOVE 0.2 mm" : "") << "\n";
+        table["largest_rise_mm"][sets[sub].first + " -> " + sets[super].first] = {{"rise_mm", rise},
+                                                                                  {"where", where}};
+      }
+      tables[name] = table;
+      std::cerr << name << " done\n";
+      out.flush();
+    }
+  }
+  document["landmark_sets"] = tables;
 }
 
 // The table on stdout and beside the JSON (scaling.accuracy.txt), which

@@ -1,6 +1,8 @@
 #include "nodes/import_markups.h"
 
+#include "core/errors.h"
 #include "core/landmarks/landmark_set.h"
+#include "core/landmarks/landmark_validation.h"
 #include "core/landmarks/slicer_markups.h"
 
 namespace mmm::nodes {
@@ -15,10 +17,23 @@ workflow::NodeSpec ImportMarkups::spec() {
 }
 
 void ImportMarkups::run(workflow::NodeContext& context) {
-  const landmarks::MarkupsReadResult result =
-      landmarks::read_slicer_markups(context.input("markups").path);
+  const std::filesystem::path& file = context.input("markups").path;
+  const landmarks::MarkupsReadResult result = landmarks::read_slicer_markups(file);
   for (const std::string& note : result.notes) context.warn(note);
-  context.info(std::to_string(result.landmarks.landmarks.size()) + " landmark(s) read");
+  // The station's anatomical checks, and the mirror check a wrong
+  // coordinateSystem fails: such a file is rejected, never scaled.
+  landmarks::AnatomyRules rules;
+  rules.declared_coordinate_system = result.coordinate_system;
+  const std::vector<std::string> reasons =
+      landmarks::check_landmark_anatomy(result.landmarks, rules);
+  if (!reasons.empty()) {
+    std::string text;
+    for (const std::string& reason : reasons) text += "\n  - " + reason;
+    throw InvalidInputError("input 'markups' (" + result.coordinate_system +
+                            " point list): the landmarks fail the anatomical checks:" + text);
+  }
+  context.info(std::to_string(result.landmarks.landmarks.size()) + " landmark(s) read (" +
+               result.coordinate_system + ")");
   context.set_output("landmarks", landmarks::landmark_set_to_json_text(result.landmarks));
 }
 

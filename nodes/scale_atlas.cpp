@@ -22,6 +22,7 @@ scaling::AtlasScalingOptions scaling_options_from(const workflow::NodeContext& c
   options.joint_weight = context.number("joint_weight");
   options.bone.laplacian_weight = context.number("laplacian_weight");
   options.bone.determined_fraction = context.number("determined_fraction");
+  options.local_radius_mm = context.number("local_radius_mm");
   options.muscle.laplacian_weight = context.number("laplacian_weight");
   options.muscle.attachment_weight = context.number("attachment_weight");
   options.muscle.contact_distance_mm = context.number("contact_distance_mm");
@@ -99,6 +100,11 @@ workflow::NodeSpec ScaleAtlas::spec() {
                      "Share of the strongest that an affine direction's landmark support needs "
                      "to be fitted rather than kept from the anatomical estimate",
                      {.min = 1e-12, .max = 1})
+      .param<double>("local_radius_mm", d.local_radius_mm,
+                     "Landmarks tagged local in the atlas (epicondyles, malleoli, heel) move "
+                     "their bone within this radius of themselves instead of stretching the "
+                     "whole bone; 0: every landmark acts on the bone's affine part",
+                     {.min = 0, .max = 500}, "mm")
       .param<double>("attachment_weight", d.muscle.attachment_weight,
                      "Weight keeping muscle vertices that touch a bone on it (per mm^2)",
                      {.min = 1e-6})
@@ -116,7 +122,10 @@ workflow::NodeSpec ScaleAtlas::spec() {
                      "mm")
       .param<std::int64_t>("threads", d.threads, "Worker threads", {.min = 1, .max = 64})
       .output<Atlas>("atlas", "The patient's atlas, in the landmarks' frame")
-      .output<Report>("report", "Landmark residuals, per-segment factors, muscles, timings")
+      .output<Report>(
+          "report",
+          "Landmark residuals, length factors (first stage and final), stretch warnings, muscles, "
+          "timings")
       .output<File>("overlay", "PNG of the scaled bones' outlines on the radiographs");
 }
 
@@ -137,6 +146,7 @@ void ScaleAtlas::run(workflow::NodeContext& context) {
     context.info("landmark " + name + ": residual " + std::to_string(residual) + " mm");
   }
   for (const std::string& note : scaled.notes) context.warn(note);
+  for (const scaling::StretchWarning& warning : scaled.warnings) context.warn(warning.message);
   context.progress(3, 5, "writing the patient's atlas");
   const std::filesystem::path out = context.scratch_dir() / "atlas_out";
   atlas::write_atlas_with_meshes(scaled.atlas, scaled.meshes, out, options.threads);

@@ -7,6 +7,7 @@
 
 #include "core/errors.h"
 #include "core/image/radiograph_pair.h"
+#include "core/landmarks/landmark_labels.h"
 #include "core/landmarks/landmark_set.h"
 #include "core/landmarks/landmark_validation.h"
 #include "worklists/task_views.h"
@@ -184,14 +185,18 @@ Json landmark_task_request(const workflow::CacheKeyParts& parts,
     landmarks.push_back({{"name", stem + suffix(side)},
                          {"label", std::string(text.label) + " (" + side + ")"},
                          {"required", stem != "ankle_centre" || require_ankle},
-                         {"hint", text.hint}});
+                         {"hint", text.hint},
+                         {"definition", landmarks::landmark_definition(stem + suffix(side))}});
   }
   // Absent from the keys of tasks opened before the parameter existed.
   const auto pelvis = parts.params.find("pelvis_landmarks");
   if (pelvis != parts.params.end() && std::get<bool>(pelvis->second)) {
     for (const LandmarkText& text : kPelvisLandmarks) {
-      landmarks.push_back(
-          {{"name", text.stem}, {"label", text.label}, {"required", true}, {"hint", text.hint}});
+      landmarks.push_back({{"name", text.stem},
+                           {"label", text.label},
+                           {"required", true},
+                           {"hint", text.hint},
+                           {"definition", landmarks::landmark_definition(text.stem)}});
     }
   }
   request["landmarks"] = landmarks;

@@ -17,6 +17,7 @@
 #include "core/atlas/atlas_recipe.h"
 #include "core/image/mesh_render.h"
 #include "core/image/png.h"
+#include "core/landmarks/landmark_labels.h"
 
 namespace mmm::app {
 namespace {
@@ -250,6 +251,14 @@ void run_show(const ShowArgs& args) {
   std::cout << "wrote " << args.png << ": front and side views with muscles, then bones only ("
             << model.bones.size() << " bones, " << model.muscles.size() << " muscles, "
             << model.structures.size() << " cartilages and ligaments)\n";
+  // The landmarks with their anatomical definitions (the manifest's).
+  std::cout << "landmarks (" << model.landmarks.size() << "):\n";
+  for (const atlas::Landmark& landmark : model.landmarks) {
+    std::string tags;
+    for (const std::string& tag : landmark.tags) tags += (tags.empty() ? "" : ", ") + tag;
+    std::cout << "  " << landmark.name << " on " << landmark.bone << " [" << tags << "]"
+              << (landmark.description.empty() ? "" : ": " + landmark.description) << '\n';
+  }
 }
 
 struct CheckArgs {
@@ -429,6 +438,16 @@ void register_atlas_commands(CLI::App& app) {
   show->add_option("--width", show_args->width, "Width of each panel (pixels)")
       ->check(CLI::Range(100, 4000));
   show->callback([show_args] { run_show(*show_args); });
+
+  auto* labels = atlas->add_subcommand(
+      "labels",
+      "Landmark labels that import_markups understands (3D Slicer point lists), with each "
+      "landmark's anatomical definition");
+  labels->callback([] {
+    std::cout << "atlas landmark (labels, case, spaces and '_' ignored; R/L before or after): "
+                 "definition\n"
+              << landmarks::landmark_label_table_text();
+  });
 
   auto check_args = std::make_shared<CheckArgs>();
   auto* check = atlas->add_subcommand(

@@ -82,8 +82,46 @@ std::string text_of(const json& value) {
   return value.is_string() ? value.get<std::string>() : value.dump();
 }
 
+// The study input (as given: a path) that feeds port `port` of the first
+// node of type `type`; "" when there is none.
+std::string given_input_of(const json& status, const std::string& type, const std::string& port) {
+  for (const json& node : status.value("nodes", json::array())) {
+    if (node.value("type", "") != type) continue;
+    const json inputs = node.value("key", json::object()).value("inputs", json::object());
+    const std::string hash = inputs.is_object() ? inputs.value(port, "") : "";
+    for (const json& input : status.value("inputs", json::array())) {
+      if (!hash.empty() && input.value("hash", "") == hash) return input.value("given", "");
+    }
+  }
+  return {};
+}
+
+// Where the landmarks came from, one sentence, from the set's source and the
+// study's nodes.
+std::string landmark_origin(const json& landmarks, const json& status) {
+  const std::string source = landmarks.value("source", "");
+  if (source == "slicer_markups") {
+    const std::string file = given_input_of(status, "import_markups", "markups");
+    return "Imported from " + (file.empty() ? std::string("a 3D Slicer point list") : file) +
+           " (import_markups: 3-D points placed in 3D Slicer, checked for anatomy and "
+           "orientation); no radiograph, so no reprojection error:";
+  }
+  if (source == "static_trial") {
+    const std::string file = given_input_of(status, "static_trial_landmarks", "trial");
+    return "From the static motion-capture trial " + (file.empty() ? std::string("(.trc)") : file) +
+           " (static_trial_landmarks: joint centres from the markers, averaged over its "
+           "frames); no radiograph:";
+  }
+  if (source == "radiographs") {
+    return "Placed by the operator at the landmark station and triangulated from both "
+           "radiographs (frontal and lateral); the reprojection error says how well the two "
+           "views agree:";
+  }
+  return "Landmarks (source: " + (source.empty() ? std::string("not stated") : source) + "):";
+}
+
 void landmarks_section(Page& page, const ReportInput& input) {
-  page.heading("landmarks", "Landmarks (landmark station)");
+  page.heading("landmarks", "Landmarks");
   std::vector<std::vector<std::string>> rows;
   for (const json& entry : input.audit) {
     // The landmarks a submission placed (its pixels are in the audit entry).
@@ -123,14 +161,17 @@ void landmarks_section(Page& page, const ReportInput& input) {
                                              : "-",
                         errors});
     }
-    page.paragraph("The accepted landmarks, triangulated from both views:");
+    page.paragraph(landmark_origin(*landmarks, input.status));
     page.add(html_table({"landmark", "position (mm)", "reprojection error (mm)"}, placed));
     if (input.truth) {
       page.add(truth_landmarks_html(*landmarks, page.outputs() / "landmarks.json", *input.truth));
     }
   }
+  const bool radiographs = !landmarks || landmarks->value("source", "") == "radiographs";
   if (!page.png("overlay", "overlay.png",
-                "The scaled bones' outlines over the frontal and lateral radiographs")) {
+                radiographs ? "The scaled bones' outlines over the frontal and lateral radiographs"
+                            : "The scaled bones, front and side (no radiographs: the landmarks "
+                              "did not come from them)")) {
     page.pending("overlay", "the scaled atlas over the radiographs (after scaling)");
   }
   page.end_section();
@@ -144,14 +185,43 @@ void scaling_section(Page& page, const ReportInput& input) {
     page.end_section();
     return;
   }
+  // The final per-bone factors (after the energy: what the patient's model
+  // has), beside the first stage's estimate for the same segment.
   std::vector<std::vector<std::string>> factors;
   const json first = report->value("first_stage", json::object());
   const json segment_factors = first.value("segment_length_factor", json::object());
-  for (const auto& [segment, factor] : segment_factors.items()) {
-    factors.push_back({segment, fixed(factor.get<double>(), 3)});
+  for (const json& bone : report->value("bones", json::array())) {
+    if (!bone.contains("length_factor") || bone.value("solve", "").starts_with("welded")) {
+      continue;
+    }
+    const std::string name = bone.value("bone", "");
+    const json stretch = bone.value("stretch_vs_first_stage", json::array());
+    std::string stretches;
+    for (const json& value : stretch) {
+      stretches += (stretches.empty() ? "" : ", ") + fixed(value.get<double>(), 2);
+    }
+    factors.push_back(
+        {name, fixed(bone["length_factor"].get<double>(), 3),
+         segment_factors.contains(name) ? fixed(segment_factors[name].get<double>(), 3) : "-",
+         stretches});
   }
-  page.paragraph("Per-segment length factors (patient / atlas):");
-  page.add(html_table({"segment", "length factor"}, factors));
+  page.paragraph(
+      "Per-bone length factors of the scaled model (patient / atlas, along the bone's "
+      "long axis), the first stage's estimate, and the stretches relative to it:");
+  page.add(html_table({"bone", "length factor", "first stage", "stretch vs first stage"}, factors));
+  std::vector<std::vector<std::string>> warnings;
+  for (const json& warning : report->value("warnings", json::array())) {
+    warnings.push_back({warning.value("bone", ""), warning.value("part", ""),
+                        warning.value("direction", ""), fixed(warning.value("factor", 1.0), 2)});
+  }
+  if (warnings.empty()) {
+    page.paragraph("No implausible stretch: every bone within 0.75-1.35 of the first stage.");
+  } else {
+    page.paragraph(
+        "Warning: implausible stretches (outside 0.75-1.35 of the first stage); "
+        "check the landmarks on these bones:");
+    page.add(html_table({"bone", "where", "direction", "factor"}, warnings));
+  }
   std::vector<std::vector<std::string>> residuals;
   const json landmark_residuals = report->value("landmark_residual_mm", json::object());
   for (const auto& [name, residual] : landmark_residuals.items()) {

@@ -228,4 +228,105 @@ ValidationResult validate_submission(std::span<const image::RadiographView> view
   return result;
 }
 
+std::vector<std::string> check_landmark_anatomy(const LandmarkSet& set, const AnatomyRules& rules) {
+  if (rules.side != "right" && rules.side != "left") {
+    throw InvalidInputError(R"(AnatomyRules.side must be "right" or "left", got ")" + rules.side +
+                            "\"");
+  }
+  std::vector<std::string> reasons;
+  const auto at = [&](const std::string& name) -> const Eigen::Vector3d* {
+    const Landmark* landmark = set.find(name);
+    return landmark == nullptr ? nullptr : &landmark->position_mm;
+  };
+  for (const std::vector<std::string>& chain : rules.top_to_bottom) {
+    std::vector<std::string> present;
+    for (const std::string& name : chain) {
+      if (at(name) != nullptr) present.push_back(name);
+    }
+    for (std::size_t i = 0; i + 1 < present.size(); ++i) {
+      const double upper = at(present[i])->z();
+      const double lower = at(present[i + 1])->z();
+      if (!(upper > lower)) {
+        reasons.push_back("Landmark '" + present[i] + "' (z = " + mm(upper) +
+                          " mm) should be above '" + present[i + 1] + "' (z = " + mm(lower) +
+                          " mm); were they swapped, or is z not superior?");
+      }
+    }
+  }
+  for (const DistanceRange& range : rules.distances) {
+    const Eigen::Vector3d* from = at(range.from);
+    const Eigen::Vector3d* to = at(range.to);
+    if (from == nullptr || to == nullptr) continue;
+    const double distance = (*from - *to).norm();
+    if (distance < range.min_mm || distance > range.max_mm) {
+      reasons.push_back("Distance from '" + range.from + "' to '" + range.to + "' is " +
+                        mm(distance) + " mm, outside the adult range [" + mm(range.min_mm) + ", " +
+                        mm(range.max_mm) + "] mm (units wrong?).");
+    }
+  }
+  // Order checks along x and y: counted, to tell a mirrored file from a
+  // misplaced point.
+  int order_checks = 0;
+  int order_failures = 0;
+  const auto order = [&](const std::string& first, const std::string& second, int axis, double sign,
+                         const char* relation) {
+    const Eigen::Vector3d* a = at(first);
+    const Eigen::Vector3d* b = at(second);
+    if (a == nullptr || b == nullptr) return;
+    ++order_checks;
+    if (sign * ((*a)(axis) - (*b)(axis)) > 0.0) return;
+    ++order_failures;
+    reasons.push_back("Landmark '" + first + "' should lie " + relation + " '" + second +
+                      "', but it lies " + mm(std::abs((*a)(axis) - (*b)(axis))) + " mm " +
+                      (axis == 1 ? "behind" : "on the other side of") + " it.");
+  };
+  for (const auto& [front, back] : rules.anterior_posterior) {
+    order(front, back, 1, 1.0, "in front of (larger y than)");
+  }
+  const double outward = rules.side == "right" ? 1.0 : -1.0;
+  for (const auto& [lateral, medial] : rules.lateral_medial) {
+    order(lateral, medial, 0, outward, "lateral of");
+  }
+  for (const auto& [right, left] : rules.right_left) {
+    order(right, left, 0, 1.0, "to the subject's right (larger x) of");
+  }
+  // Side of the midline.
+  std::optional<double> midline;
+  for (const std::string& name : rules.midline) {
+    if (const Eigen::Vector3d* p = at(name)) midline = p->x();
+  }
+  if (!midline && !rules.right_left.empty()) {
+    const Eigen::Vector3d* right = at(rules.right_left.front().first);
+    const Eigen::Vector3d* left = at(rules.right_left.front().second);
+    if (right != nullptr && left != nullptr) midline = 0.5 * (right->x() + left->x());
+  }
+  if (midline) {
+    for (const Landmark& landmark : set.landmarks) {
+      if (std::ranges::find(rules.midline, landmark.name) != rules.midline.end()) continue;
+      const bool other =
+          std::ranges::find(rules.opposite_side, landmark.name) != rules.opposite_side.end();
+      const bool expect_right = (rules.side == "right") != other;
+      ++order_checks;
+      const double lateral =
+          expect_right ? landmark.position_mm.x() - *midline : *midline - landmark.position_mm.x();
+      if (lateral >= rules.side_margin_mm) continue;
+      ++order_failures;
+      reasons.push_back("Landmark '" + landmark.name + "' should lie at least " +
+                        mm(rules.side_margin_mm) + " mm to the subject's " +
+                        (expect_right ? "right" : "left") + " of the midline (x = " + mm(*midline) +
+                        " mm), got " + mm(lateral) + " mm.");
+    }
+  }
+  if (order_failures > 0 && order_failures == order_checks) {
+    const bool declared_ras = rules.declared_coordinate_system == "RAS";
+    const std::string really = declared_ras ? "LPS" : "RAS";
+    reasons.push_back("Every front-back and left-right order is reversed: the points look like " +
+                      really + " coordinates read as " + rules.declared_coordinate_system +
+                      " (x and y negated; the model would come out turned by 180 degrees). "
+                      "Hint: set the point list's coordinateSystem to \"" +
+                      really + "\" (Slicer writes LPS), or export the points again.");
+  }
+  return reasons;
+}
+
 }  // namespace mmm::landmarks

@@ -23,6 +23,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/image/projection.h"
@@ -132,5 +133,62 @@ double central_ray_crossing_x(std::span<const image::RadiographView> views);
 ValidationResult validate_submission(std::span<const image::RadiographView> views,
                                      const PixelSubmission& submission,
                                      const ValidationRules& rules = {});
+
+// The anatomical checks of 3-D landmarks that did not come from the station
+// (a Slicer import, a static trial): the same heights, distances and sides as
+// validate_submission, plus the front-to-back and left-to-right order of
+// pairs, which a mirrored file breaks. x toward the subject's right, y
+// anterior, z superior (RAS), mm. Only landmarks present are checked.
+struct AnatomyRules {
+  // Each chain superior to inferior: every present landmark higher (z) than
+  // the next present one.
+  std::vector<std::vector<std::string>> top_to_bottom = {
+      {"asis_r", "femoral_head_centre_r", "patella_centre_r", "ankle_centre_r"},
+      {"asis_l", "femoral_head_centre_r"},
+      {"femoral_head_centre_r", "knee_centre_r", "ankle_centre_r"}};
+  // (anterior, posterior): the first lies in front (larger y). In the VHF
+  // atlas the margins are 42-140 mm (patella - femoral head: 27 mm), far
+  // beyond what posture or anatomy changes; all of them flip in a file whose
+  // x and y are negated.
+  std::vector<std::pair<std::string, std::string>> anterior_posterior = {
+      {"asis_r", "sacral_point"},
+      {"asis_l", "sacral_point"},
+      {"asis_r", "femoral_head_centre_r"},
+      {"patella_centre_r", "knee_centre_r"},
+      {"patella_centre_r", "femoral_head_centre_r"},
+      {"patella_centre_r", "ankle_centre_r"},
+      {"ankle_centre_r", "heel_r"}};
+  // (lateral, medial) on the leg's side: the first lies farther out.
+  std::vector<std::pair<std::string, std::string>> lateral_medial = {
+      {"lateral_epicondyle_r", "medial_epicondyle_r"},
+      {"lateral_malleolus_r", "medial_malleolus_r"}};
+  // (right, left): the first lies to the subject's right (larger x).
+  std::vector<std::pair<std::string, std::string>> right_left = {{"asis_r", "asis_l"}};
+  // The leg ("right" or "left"); its landmarks (every present one except
+  // the midline and opposite-side ones below) must lie on its side of the
+  // midline by side_margin_mm. The midline is the x of the sacral point, else
+  // of the middle of the two ASIS; without them the side is not checked.
+  std::string side = "right";
+  double side_margin_mm = 10.0;  // as ValidationRules::side_margin_mm
+  std::vector<std::string> midline = {"sacral_point"};
+  std::vector<std::string> opposite_side = {"asis_l"};
+  // As ValidationRules::distances, with the ASIS span (160-340 mm: adult
+  // inter-ASIS distances are 200-290 mm, widened for obesity and children).
+  std::vector<DistanceRange> distances = {
+      {"femoral_head_centre_r", "patella_centre_r", 250.0, 550.0},
+      {"patella_centre_r", "ankle_centre_r", 270.0, 620.0},
+      {"asis_r", "asis_l", 160.0, 340.0}};
+  // The coordinate system the file declared, named in the hint for mirrored points.
+  std::string declared_coordinate_system = "RAS";
+};
+
+// One sentence per problem found (empty: the set passes). When order checks
+// fail and every one of them would pass with x and y negated, the last
+// sentence says the points look mirrored and names the coordinate system
+// that would fix it ("the points look like LPS coordinates read as RAS ...;
+// set the point list's coordinateSystem to \"LPS\""). Throws
+// InvalidInputError for bad rules (side not "right"/"left").
+std::vector<std::string> check_landmark_anatomy(const LandmarkSet& set,
+                                                const AnatomyRules& rules = {});
 
 }  // namespace mmm::landmarks

@@ -8,6 +8,7 @@
 #include "core/bounded_json.h"
 #include "core/errors.h"
 #include "core/file_bytes.h"
+#include "core/landmarks/landmark_labels.h"
 #include "core/landmarks/message_text.h"
 
 namespace mmm::landmarks {
@@ -22,18 +23,6 @@ constexpr const char* kSchema =
     "Schema/markups-schema-v1.0.3.json#";
 
 using detail::describe_json;
-
-std::string normalise(std::string_view label) {
-  std::string out;
-  for (const char c : label) {
-    if (c == ' ' || c == '-' || c == '_' || c == '.' || c == '\t') continue;
-    out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  }
-  for (std::size_t at = out.find("center"); at != std::string::npos; at = out.find("center")) {
-    out.replace(at, 6, "centre");
-  }
-  return out;
-}
 
 std::string read_text(const fs::path& file) {
   std::error_code error;
@@ -105,6 +94,7 @@ class MarkupsReader {
       }
       system = it->get<std::string>();
     }
+    result_.coordinate_system = system;
     double scale = 1.0;  // to mm
     if (const auto it = entry.find("coordinateUnits"); it != entry.end()) {
       const std::string units = it->is_string() ? it->get<std::string>() : "";
@@ -174,10 +164,13 @@ class MarkupsReader {
     }
     std::string name = match_landmark_name(label, options_);
     if (name.empty()) {
-      name = label;
-      result_.notes.push_back(where + ": label '" + label +
-                              "' matches no landmark name; kept as it is");
-    } else if (name != label) {
+      fail(where + ".label", "'" + label +
+                                 "' names no landmark mmm knows; hint: rename the point in "
+                                 "Slicer to an atlas name or one of its labels (case, spaces "
+                                 "and '_' do not matter):\n" +
+                                 landmark_label_table_text());
+    }
+    if (name != label) {
       result_.notes.push_back(where + ": label '" + label + "' read as '" + name + "'");
     }
     if (const auto [it, inserted] = first_path_.emplace(name, where); !inserted) {
@@ -198,32 +191,11 @@ class MarkupsReader {
 
 }  // namespace
 
-std::map<std::string, std::string> default_landmark_aliases() {
-  const std::map<std::string, std::vector<std::string>> by_name = {
-      {"femoral_head_centre_r", {"femoralhead", "femoralheadcentre", "hipcentre", "hjc"}},
-      {"patella_centre_r", {"patella", "patellacentre"}},
-      {"ankle_centre_r", {"ankle", "anklecentre", "ajc"}},
-      {"knee_centre_r", {"knee", "kneecentre", "kjc"}}};
-  std::map<std::string, std::string> aliases;
-  for (const auto& [name, stems] : by_name) {
-    for (const std::string& stem : stems) {
-      for (const char* suffix : {"", "r", "right"}) aliases[stem + suffix] = name;
-    }
-  }
-  return aliases;
-}
-
 std::string match_landmark_name(std::string_view label, const MarkupsReadOptions& options) {
-  for (const std::string& name : options.landmark_names) {
-    if (name == label) return name;
-  }
-  const std::string key = normalise(label);
-  if (key.empty()) return {};
-  for (const std::string& name : options.landmark_names) {
-    if (normalise(name) == key) return name;
-  }
-  if (const auto it = options.aliases.find(key); it != options.aliases.end()) return it->second;
-  return {};
+  if (find_landmark_labels(label) != nullptr) return std::string(label);
+  if (std::string name = landmark_for_label(label); !name.empty()) return name;
+  const auto it = options.aliases.find(normalise_label(label));
+  return it == options.aliases.end() ? std::string() : it->second;
 }
 
 MarkupsReadResult read_slicer_markups(const fs::path& file, const MarkupsReadOptions& options) {

@@ -16,9 +16,12 @@
 //
 // Labels become landmark names (match_landmark_name): exactly, else ignoring
 // case, spaces, '-', '_', '.' and the spelling "center"/"centre"
-// ("Femoral Head Center R" -> femoral_head_centre_r), else through the alias
-// table of MarkupsReadOptions. A label that matches nothing is kept as it is,
-// with a note, so that a later check (landmark_validation.h) names it.
+// ("Femoral Head Center R" -> femoral_head_centre_r), else through the label
+// table of landmark_labels.h ("RASIS", "R Knee Lat", "Calcaneus", ...), else
+// through the extra aliases of MarkupsReadOptions. A label that matches
+// nothing is an error listing every landmark, its labels and its definition:
+// a point silently dropped would scale the atlas on fewer landmarks than the
+// person who placed them meant.
 
 #include <filesystem>
 #include <map>
@@ -30,22 +33,10 @@
 
 namespace mmm::landmarks {
 
-// The default alias table, keyed by the normalised label (lower case, no
-// spaces, '-', '_' or '.', "center" spelt "centre"). Side-less names mean the
-// right leg, the leg of mmm's atlas:
-//   femoralhead, femoralheadcentre, hipcentre, hjc      -> femoral_head_centre_r
-//   patella, patellacentre                               -> patella_centre_r
-//   ankle, anklecentre, ajc                              -> ankle_centre_r
-//   knee, kneecentre, kjc                                -> knee_centre_r
-// and the same with a trailing "r" / "right" ("femoralheadright").
-std::map<std::string, std::string> default_landmark_aliases();
-
 struct MarkupsReadOptions {
-  // Landmark names labels are matched against.
-  std::vector<std::string> landmark_names = {"femoral_head_centre_r", "patella_centre_r",
-                                             "ankle_centre_r", "knee_centre_r"};
-  // Normalised label -> landmark name (see default_landmark_aliases).
-  std::map<std::string, std::string> aliases = default_landmark_aliases();
+  // Normalised label (landmark_labels.h: normalise_label) -> landmark name,
+  // tried after the label table: a site's own habits.
+  std::map<std::string, std::string> aliases;
 };
 
 // The landmark name for a Slicer label, or "" when nothing matches (see the
@@ -54,17 +45,22 @@ std::string match_landmark_name(std::string_view label, const MarkupsReadOptions
 
 struct MarkupsReadResult {
   LandmarkSet landmarks;  // frame "patient" (RAS, mm), source "slicer_markups", file order
-  // One sentence per point skipped, label renamed or kept unmatched, markup of
-  // another type ignored.
+  // One sentence per point skipped, label renamed, markup of another type
+  // ignored.
   std::vector<std::string> notes;
+  // The coordinate system the point lists declared ("LPS" when they declared
+  // none, Slicer's default), for the hint of a check that finds the points
+  // mirrored (landmark_validation.h: check_landmark_anatomy).
+  std::string coordinate_system = "LPS";
 };
 
 // Reads a .mrk.json file. Throws IoError naming the file and the JSON path
 // ("markups[0].controlPoints[2].position must be 3 finite numbers, got ...")
 // for: a missing or unreadable file, invalid JSON, no "markups" array, a
 // point list whose coordinateSystem is not LPS/RAS or whose coordinateUnits
-// are not mm/um/m, a control point without a 3-number position, no point
-// list at all, or two points that become the same landmark name.
+// are not mm/um/m, a control point without a 3-number position, a label that
+// names no landmark (the message lists the table of landmark_labels.h), no
+// point list at all, or two points that become the same landmark name.
 MarkupsReadResult read_slicer_markups(const std::filesystem::path& file,
                                       const MarkupsReadOptions& options = {});
 

@@ -1,7 +1,9 @@
 #include "core/scaling/atlas_scaling.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <chrono>
+#include <sstream>
 
 #include "core/atlas/bone_registration.h"
 #include "core/atlas/kinematic_chain.h"
@@ -134,9 +136,20 @@ std::shared_ptr<const PreparedAtlas> prepare_atlas(atlas::Atlas atlas, atlas::At
 
 namespace {
 
+// The placed full surfaces and affine parts of the bones, filled in chain order.
+struct PlacedBones {
+  std::map<std::string, Eigen::MatrixX3d> vertices;
+  std::map<std::string, Affine3d> affine;
+  std::map<std::string, LocalField> local;  // step 1b's field, shared with welded bones
+};
+
+bool is_local(const atlas::Landmark& landmark) {
+  return std::ranges::find(landmark.tags, "local") != landmark.tags.end();
+}
+
 std::vector<PointTerm> bone_terms(const PreparedAtlas& prepared, const atlas::Bone& bone,
                                   const landmarks::LandmarkSet& set, const ScalingEstimate& first,
-                                  const BonePlacement& placed, const AtlasScalingOptions& options) {
+                                  const PlacedBones& placed, const AtlasScalingOptions& options) {
   const atlas::Atlas& a = prepared.atlas;
   const AnchorBuilder& anchors = *prepared.anchors.at(bone.name);
   std::vector<PointTerm> terms;
@@ -147,7 +160,8 @@ std::vector<PointTerm> bone_terms(const PreparedAtlas& prepared, const atlas::Bo
     // with its affine part.
     if (landmark == nullptr || moving_with(a, landmark->bone) != bone.name) continue;
     terms.push_back({"landmark " + given.name, anchors.anchor(landmark->position),
-                     landmark->position, given.position_mm, options.landmark_weight});
+                     landmark->position, given.position_mm, options.landmark_weight,
+                     is_local(*landmark) ? options.local_radius_mm : 0.0});
   }
   // Proximal joint: where the (already placed) parent puts the joint centre.
   if (const atlas::Joint* joint = joint_to(a, bone.name)) {
@@ -188,6 +202,67 @@ BoneScaling describe_bone(const atlas::Atlas& a, const atlas::Bone& bone, const 
     out.length_factor = 0.0;
   }
   return out;
+}
+
+std::string direction_name(const Vector3d& direction) {
+  Eigen::Index axis = 0;
+  direction.cwiseAbs().maxCoeff(&axis);
+  return axis == 0 ? "medio-lateral (x)" : axis == 1 ? "antero-posterior (y)" : "vertical (z)";
+}
+
+// The stretches of `bone` relative to the first stage's linear part M0, and
+// a warning for every one outside the options' range.
+void measure_stretch(BoneScaling& bone, const Eigen::Matrix3d& first_stage, const LocalField& local,
+                     const Eigen::MatrixX3d& rest, const AtlasScalingOptions& options,
+                     std::vector<StretchWarning>& warnings) {
+  const Eigen::Matrix3d first_inverse = first_stage.inverse();
+  const auto outside = [&](double factor) {
+    return factor < options.stretch_min || factor > options.stretch_max;
+  };
+  const auto warn = [&](const std::string& part, const Vector3d& direction, double factor) {
+    StretchWarning warning{bone.bone, part, direction_name(direction), factor, ""};
+    std::ostringstream text;
+    text.precision(3);
+    text << bone.bone << ": " << (part == "affine" ? "the whole bone" : "near its local landmarks")
+         << " is stretched x" << factor << " in the " << warning.direction
+         << " direction relative to the first stage (plausible " << options.stretch_min << "-"
+         << options.stretch_max << "); check the landmarks on it";
+    warning.message = text.str();
+    warnings.push_back(std::move(warning));
+  };
+  const Eigen::JacobiSVD<Eigen::Matrix3d> affine(bone.affine.linear() * first_inverse,
+                                                 Eigen::ComputeFullU);
+  bone.stretch_vs_first_stage = affine.singularValues();
+  for (int i = 0; i < 3; ++i) {
+    if (outside(affine.singularValues()[i])) {
+      warn("affine", affine.matrixU().col(i), affine.singularValues()[i]);
+    }
+  }
+  if (local.empty()) return;
+  double lowest = 1.0;
+  double highest = 1.0;
+  Vector3d low_direction = Vector3d::UnitX();
+  Vector3d high_direction = Vector3d::UnitX();
+  for (Eigen::Index v = 0; v < rest.rows(); ++v) {
+    const Vector3d point = rest.row(v).transpose();
+    const Eigen::Matrix3d gradient = local.gradient(point);
+    if (gradient.isZero(0.0)) continue;
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd((bone.affine.linear() + gradient) * first_inverse,
+                                                Eigen::ComputeFullU);
+    const Vector3d sigma = svd.singularValues();
+    if (sigma[0] > highest) {
+      highest = sigma[0];
+      high_direction = svd.matrixU().col(0);
+    }
+    if (sigma[2] < lowest) {
+      lowest = sigma[2];
+      low_direction = svd.matrixU().col(2);
+    }
+  }
+  bone.local_stretch_min = lowest;
+  bone.local_stretch_max = highest;
+  if (outside(highest)) warn("local", high_direction, highest);
+  if (outside(lowest)) warn("local", low_direction, lowest);
 }
 
 void place_elements(const PreparedAtlas& prepared, const BonePlacement& placed,
@@ -267,7 +342,7 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
 
   // Bones, root first.
   Clock::time_point stage = Clock::now();
-  BonePlacement placed;
+  PlacedBones placed;
   for (const atlas::Bone* bone : chain_order(a, "atlas scaling")) {
     const atlas::Joint* joint = joint_to(a, bone->name);
     const mesh::IndexedMesh& rest = full_mesh(prepared.meshes, bone->name);
@@ -277,8 +352,14 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
       report = describe_bone(a, *bone, parent);
       report.welded_to = joint->parent;
       placed.affine[bone->name] = parent;
+      // The parent's local field too: a malleolus on the fibula moves the
+      // fibula's end with the tibia's.
+      const LocalField& local = placed.local.at(joint->parent);
+      placed.local[bone->name] = local;
       placed.vertices[bone->name] =
-          (rest.V * parent.linear().transpose()).rowwise() + parent.translation().transpose();
+          Eigen::MatrixX3d((rest.V * parent.linear().transpose()).rowwise() +
+                           parent.translation().transpose()) +
+          local.displacements(rest.V);
     } else {
       const std::vector<PointTerm> terms =
           bone_terms(prepared, *bone, landmarks, scaled.first_stage, placed, options);
@@ -288,15 +369,22 @@ ScaledAtlas scale_atlas(const PreparedAtlas& prepared, const landmarks::Landmark
       report.solved = solution.solved;
       report.bent = solution.bent;
       report.free_directions = solution.free_directions;
-      for (const PointTerm& term : terms) report.terms.push_back(term.name);
+      for (const PointTerm& term : terms) {
+        report.terms.push_back(term.name);
+        if (term.falloff_radius_mm > 0.0) ++report.local_points;
+      }
       report.term_residual_mm = solution.residual_mm;
+      measure_stretch(report, scaled.first_stage.deformation.bone_maps.at(bone->name).linear(),
+                      solution.local, rest.V, options, scaled.warnings);
+      placed.local[bone->name] = std::move(solution.local);
       placed.affine[bone->name] = solution.affine;
       placed.vertices[bone->name] = std::move(solution.vertices);
     }
     scaled.bones.push_back(std::move(report));
   }
   scaled.timings.bones_s = seconds_since(stage);
-  carry_atlas(prepared, placed, options, scaled);
+  carry_atlas(prepared, BonePlacement{std::move(placed.vertices), std::move(placed.affine)},
+              options, scaled);
   for (const landmarks::Landmark& given : landmarks.landmarks) {
     for (const atlas::Landmark& landmark : scaled.atlas.landmarks) {
       if (landmark.name == given.name) {
@@ -404,6 +492,24 @@ nlohmann::json scaling_report_json(const ScaledAtlas& scaled) {
   report["landmark_residual_mm"] = scaled.landmark_residual_mm;
   report["unused_landmarks"] = scaled.unused_landmarks;
   report["notes"] = scaled.notes;
+  json warnings = json::array();
+  for (const StretchWarning& warning : scaled.warnings) {
+    warnings.push_back({{"bone", warning.bone},
+                        {"part", warning.part},
+                        {"direction", warning.direction},
+                        {"factor", warning.factor},
+                        {"message", warning.message}});
+  }
+  report["warnings"] = warnings;
+  // The final per-bone length factors (after the energy), beside the first
+  // stage's per-segment ones below.
+  json final_factors = json::object();
+  for (const BoneScaling& bone : scaled.bones) {
+    if (bone.length_factor > 0.0 && bone.welded_to.empty()) {
+      final_factors[bone.bone] = bone.length_factor;
+    }
+  }
+  report["length_factor"] = final_factors;
   const ScalingEstimate& first = scaled.first_stage;
   report["first_stage"] = {{"stature_scale", first.stature_scale},
                            {"knee_rotation_deg", first.knee_rotation_deg},
@@ -418,7 +524,14 @@ nlohmann::json scaling_report_json(const ScaledAtlas& scaled) {
                                           : "first stage (meets every term)"},
                   {"affine_directions_from_first_stage", bone.free_directions},
                   {"stretches", {bone.stretches.x(), bone.stretches.y(), bone.stretches.z()}},
+                  {"stretch_vs_first_stage",
+                   {bone.stretch_vs_first_stage.x(), bone.stretch_vs_first_stage.y(),
+                    bone.stretch_vs_first_stage.z()}},
                   {"volume_scale", bone.affine.linear().determinant()}};
+    if (bone.local_points > 0) {
+      entry["local_landmarks"] = bone.local_points;
+      entry["local_stretch_range"] = {bone.local_stretch_min, bone.local_stretch_max};
+    }
     if (bone.length_factor > 0.0) entry["length_factor"] = bone.length_factor;
     json terms = json::array();
     for (std::size_t t = 0; t < bone.terms.size(); ++t) {

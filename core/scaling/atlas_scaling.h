@@ -60,6 +60,21 @@ struct AtlasScalingOptions {
   double landmark_weight = 100.0;    // per mm^2
   double joint_weight = 100.0;       // per mm^2: a bone's joint with its parent
   double distal_joint_weight = 1.0;  // per mm^2: its joints with its children
+  // Landmarks tagged "local" in the atlas (surface landmarks: epicondyles,
+  // malleoli, heel) act within this radius of themselves (bone_energy.h,
+  // step 1b) instead of on the bone's affine part. 60 mm: about the size of
+  // a bone's end (the distal femur's condyles, the calcaneus), so an
+  // epicondyle moves its condyle and the metaphysis above it, not the shaft.
+  double local_radius_mm = 60.0;
+  // A bone whose stretch relative to the first stage (singular values of
+  // its affine part times the first stage's inverse, or of the local
+  // deformation gradient) leaves [stretch_min, stretch_max] in any
+  // direction is reported as implausible. Adult bones vary in proportion by
+  // about +-15 % around the stature's prediction (Winter 2009, table 4.1,
+  // segment lengths over stature); 0.75-1.35 is twice that, so a warning
+  // means a misplaced or mislabelled landmark, not an unusual patient.
+  double stretch_min = 0.75;
+  double stretch_max = 1.35;
   int anchor_vertices = 16;
   int threads = 2;
 };
@@ -102,6 +117,24 @@ struct BoneScaling {
   Eigen::Vector3d stretches;       // singular values of the affine's linear part, largest first
   std::vector<std::string> terms;  // point terms used, in order
   std::vector<double> term_residual_mm;  // |reconstructed - target| per term
+  // Singular values of affine.linear() times the first stage's inverse,
+  // largest first: 1 where the landmarks agree with the first stage.
+  Eigen::Vector3d stretch_vs_first_stage = Eigen::Vector3d::Ones();
+  // Smallest and largest singular value of the local deformation gradient
+  // (times the first stage's inverse) over the surface the local field
+  // moves; 1, 1 without local landmarks.
+  double local_stretch_min = 1.0;
+  double local_stretch_max = 1.0;
+  int local_points = 0;  // local landmarks acting on it (bone_energy.h, step 1b)
+};
+
+// A stretch outside [stretch_min, stretch_max] (AtlasScalingOptions).
+struct StretchWarning {
+  std::string bone;
+  std::string part;       // "affine" (the whole bone) or "local" (near its local landmarks)
+  std::string direction;  // "medio-lateral (x)", "antero-posterior (y)" or "vertical (z)"
+  double factor = 1.0;
+  std::string message;  // one sentence for people
 };
 
 struct MuscleScaling {
@@ -127,6 +160,7 @@ struct ScaledAtlas {
   std::map<std::string, double> landmark_residual_mm;
   std::vector<std::string> unused_landmarks;  // in the set, not in the atlas
   std::vector<std::string> notes;
+  std::vector<StretchWarning> warnings;
   ScalingTimings timings;
 };
 
@@ -152,7 +186,8 @@ struct BonePlacement {
 void carry_atlas(const PreparedAtlas& prepared, const BonePlacement& placed,
                  const AtlasScalingOptions& options, ScaledAtlas& scaled);
 
-// The report people read (residuals, per-segment factors, muscles, timings).
+// The report people read (residuals, per-segment factors, final per-bone
+// length factors and stretches, stretch warnings, muscles, timings).
 nlohmann::json scaling_report_json(const ScaledAtlas& scaled);
 
 }  // namespace mmm::scaling

@@ -71,8 +71,8 @@ BoneSolution solve_bone(const mesh::IndexedMesh& rest, const Eigen::Affine3d& pr
     return solution;
   }
 
-  // 1. The affine part: the point terms' least squares, the prior filling
-  //    the directions they leave open.
+  // 1. The affine part: the global point terms' least squares, the prior
+  //    filling the directions they leave open.
   const double radius = std::sqrt(Y.rowwise().squaredNorm().mean());
   const auto m = static_cast<Eigen::Index>(terms.size());
   MatrixXd P(m, 4);
@@ -85,12 +85,18 @@ BoneSolution solve_bone(const mesh::IndexedMesh& rest, const Eigen::Affine3d& pr
     w[j] = term.weight;
     targets.row(j) = term.target.transpose();
   }
+  // Local points take no part in the affine fit (weight 0 in its normal matrix).
+  VectorXd w_affine = w;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    if (terms[static_cast<std::size_t>(j)].falloff_radius_mm > 0.0) w_affine[j] = 0.0;
+  }
   // In units of mm (h = D g, D = diag(R, R, R, 1)), the points' normal
   // matrix; its eigenvectors with enough weight are fitted, the others keep
   // the prior (a point pair 1 mm apart must not decide how the whole bone
   // shears).
   const Vector4d D(radius, radius, radius, 1.0);
-  const Matrix4d normal = D.cwiseInverse().asDiagonal() * (P.transpose() * w.asDiagonal() * P) *
+  const Matrix4d normal = D.cwiseInverse().asDiagonal() *
+                          (P.transpose() * w_affine.asDiagonal() * P) *
                           D.cwiseInverse().asDiagonal();
   const Eigen::SelfAdjointEigenSolver<Matrix4d> eigen(normal);
   const double largest = eigen.eigenvalues().maxCoeff();
@@ -98,7 +104,7 @@ BoneSolution solve_bone(const mesh::IndexedMesh& rest, const Eigen::Affine3d& pr
   solution.free_directions = 0;
   for (int i = 0; i < 4; ++i) {
     const double lambda = eigen.eigenvalues()[i];
-    if (lambda > options.determined_fraction * largest && lambda > 0.0) {
+    if (largest > 0.0 && lambda > options.determined_fraction * largest) {
       fitted_inverse +=
           eigen.eigenvectors().col(i) * eigen.eigenvectors().col(i).transpose() / lambda;
     } else {
@@ -111,17 +117,41 @@ BoneSolution solve_bone(const mesh::IndexedMesh& rest, const Eigen::Affine3d& pr
     const VectorXd misfit = targets.col(k) - P * g0.col(k);
     const Vector4d step = D.cwiseInverse().asDiagonal() *
                           (fitted_inverse * (D.cwiseInverse().asDiagonal() *
-                                             (P.transpose() * (w.asDiagonal() * misfit))));
+                                             (P.transpose() * (w_affine.asDiagonal() * misfit))));
     g.col(k) = g0.col(k) + step;
   }
   solution.affine = affine_from(g, c);
   solution.vertices = place(solution.affine);
+
+  // 1b. The local points: what they still miss, as a field that fades out
+  //     within their radius, zero at the global points.
+  if (std::ranges::any_of(terms, [](const PointTerm& t) { return t.falloff_radius_mm > 0.0; })) {
+    std::vector<LocalPoint> points;
+    points.reserve(terms.size());
+    for (const PointTerm& term : terms) {
+      LocalPoint point{term.rest,
+                       term.target - solution.affine * term.rest,
+                       term.falloff_radius_mm,
+                       {},
+                       term.anchor.weights};
+      for (const int v : term.anchor.vertices)
+        point.samples.emplace_back(rest.V.row(v).transpose());
+      points.push_back(std::move(point));
+    }
+    solution.local = fit_local_field(points);
+    solution.vertices += solution.local.displacements(rest.V);
+  }
   solution.residual_mm = residuals(terms, solution.vertices);
   solution.solved = true;
-  if (std::ranges::all_of(solution.residual_mm,
-                          [&](double r) { return r <= options.closed_form_tolerance_mm; })) {
-    return solution;
+  // A bend only for what the affine part misses: a local point's remaining
+  // residual (a welded bone's landmark, met on its own bone) is no reason to
+  // bend the whole surface.
+  bool missed = false;
+  for (std::size_t j = 0; j < terms.size(); ++j) {
+    missed = missed || (terms[j].falloff_radius_mm <= 0.0 &&
+                        solution.residual_mm[j] > options.closed_form_tolerance_mm);
   }
+  if (!missed) return solution;
 
   // 2. The detail: what no affine map explains, as a smooth bend d with
   //    the least change of the differential coordinates.

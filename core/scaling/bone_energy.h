@@ -27,8 +27,17 @@
 //       min w_L |L d|^2 + sum_j w_j |a_j . (x_affine + d) - p_j|^2 + w_d |d|^2,
 //     L the cotangent Laplacian, w_d a tiny gauge: a smooth bend, one
 //     sparse Cholesky factorisation shared by the three coordinates.
+// Local points (falloff_radius_mm > 0: surface landmarks such as the
+// epicondyles, malleoli or heel) stay out of step 1: the affine part follows
+// what determines the whole bone (joint centres, the station's centres) and
+// a local point moves only the part of the bone around it, through a
+// compactly supported displacement field (local_field.h, radius R) fitted
+// to its misfit after step 1, zero at the other points:
+//  1b. x = x_affine + d_local(v), d_local = 0 beyond R of every local point.
+// So two epicondyles widen the distal femur, not the shaft, and a heel
+// placed 40 mm off drags the back of the calcaneus, not the whole foot.
 // When g0 already meets every point term within closed_form_tolerance_mm
-// nothing is solved (E = 0 there); when the affine fit meets them, no bend.
+// nothing is solved (E = 0 there); when steps 1 and 1b meet them, no bend.
 
 #include <Eigen/Geometry>
 #include <string>
@@ -36,6 +45,7 @@
 
 #include "core/mesh/mesh.h"
 #include "core/scaling/affine_anchor.h"
+#include "core/scaling/local_field.h"
 
 namespace mmm::scaling {
 
@@ -52,6 +62,9 @@ struct PointTerm {
   Eigen::Vector3d rest = Eigen::Vector3d::Zero();    // the point on the rest surface (mm)
   Eigen::Vector3d target = Eigen::Vector3d::Zero();  // where it should go (mm)
   double weight = 1.0;                               // w_j (per mm^2)
+  // > 0: a local point (step 1b), acting within this radius of its rest
+  // position (mm); 0: it takes part in the bone's affine part.
+  double falloff_radius_mm = 0.0;
 };
 
 struct BoneSolution {
@@ -60,6 +73,9 @@ struct BoneSolution {
   bool solved = false;        // false: closed form (g0 met every term)
   bool bent = false;          // true: step 2 ran (no affine map met every term)
   int free_directions = 0;    // affine parameter directions kept from g0 (of 4 per coordinate)
+  // Step 1b's field (empty without local points), in the rest frame: the
+  // placed surface is affine(v) + local.displacement(v) (+ the bend).
+  LocalField local;
   // Per point term: |reconstructed point - target| (mm), in the given order.
   std::vector<double> residual_mm;
 };

@@ -162,6 +162,14 @@ void AtlasCliTest::show_writes_a_picture() {
   EXPECT_GT(rgb.width, 2 * 200);
   EXPECT_LE(rgb.width, 4 * 200 + 3 * 10);
   EXPECT_GT(rgb.height, 200);
+  // The landmarks with their anatomical definitions (the manifest's).
+  EXPECT_NE(shown.out.find("lateral_epicondyle_r on femur_r [landmark, right, bony, local]: "
+                           "Lateral femoral epicondyle: the most prominent point"),
+            std::string::npos)
+      << shown.out;
+  const CommandResult labels = run_mmm("atlas labels");
+  ASSERT_EQ(labels.exit_code, 0) << labels.err;
+  EXPECT_NE(labels.out.find("asis_r (R ASIS"), std::string::npos) << labels.out;
 }
 
 void AtlasCliTest::patient_radiographs_show_the_anatomy() {

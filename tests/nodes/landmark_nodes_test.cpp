@@ -94,6 +94,74 @@ TEST(ImportMarkupsTest, ReadsAnLpsPointListIntoThePatientFrame) {
   EXPECT_EQ(set.source, "slicer_markups");
 }
 
+// A Slicer point list of the default atlas's bony landmarks (RAS, mm) with
+// the labels people use, declared as `system`; `negate` flips x and y.
+std::string atlas_point_list(const std::string& system, bool negate) {
+  const std::vector<std::pair<std::string, Eigen::Vector3d>> points = {
+      {"Femoral Head Center R", {637.1, 448.8, 882.9}},
+      {"Patella", {637.9, 475.9, 513.0}},
+      {"Ankle Centre", {583.3, 407.5, 143.8}},
+      {"RASIS", {677.4, 491.3, 975.8}},
+      {"LASIS", {400.1, 497.5, 978.7}},
+      {"V Sacral", {535.7, 350.6, 961.5}},
+      {"R Knee Lat", {656.1, 419.6, 504.3}},
+      {"RME", {578.2, 433.1, 505.2}},
+      {"Lateral Malleolus R", {616.9, 395.9, 155.2}},
+      {"R Ankle Med", {571.3, 413.4, 171.8}},
+      {"Heel", {575.7, 355.3, 142.1}}};
+  Json list = Json::array();
+  for (const auto& [label, p] : points) {
+    const double s = negate ? -1.0 : 1.0;
+    list.push_back({{"label", label}, {"position", {s * p.x(), s * p.y(), p.z()}}});
+  }
+  return Json{{"markups", Json::array({{{"type", "Fiducial"},
+                                        {"coordinateSystem", system},
+                                        {"controlPoints", list}}})}}
+      .dump();
+}
+
+std::string import_error(const std::string& file) {
+  test::NodeHarness harness;
+  try {
+    harness.run<ImportMarkups>({{"markups", harness.add(PortType::kFile, file)}});
+  } catch (const std::exception& error) {
+    return error.what();
+  }
+  return "(no error)";
+}
+
+TEST(ImportMarkupsTest, ARightFilePassesAndAMirroredOneIsRejectedWithTheHint) {
+  test::NodeHarness harness;
+  const auto outputs = harness.run<ImportMarkups>(
+      {{"markups", harness.add(PortType::kFile, atlas_point_list("RAS", false))}});
+  const landmarks::LandmarkSet set = read_set(outputs.at("landmarks"));
+  EXPECT_EQ(set.landmarks.size(), 11U);
+  ASSERT_NE(set.find("medial_epicondyle_r"), nullptr);
+  EXPECT_EQ(set.find("heel_r")->position_mm, Eigen::Vector3d(575.7, 355.3, 142.1));
+  // The same points with x and y negated, still declared RAS: LPS really.
+  const std::string mirrored = import_error(atlas_point_list("RAS", true));
+  EXPECT_NE(mirrored.find("fail the anatomical checks"), std::string::npos) << mirrored;
+  EXPECT_NE(mirrored.find("the points look like LPS coordinates read as RAS"), std::string::npos)
+      << mirrored;
+  EXPECT_NE(mirrored.find("coordinateSystem to \"LPS\""), std::string::npos) << mirrored;
+  // Declared LPS, they are read right.
+  test::NodeHarness lps;
+  EXPECT_NO_THROW(lps.run<ImportMarkups>(
+      {{"markups", lps.add(PortType::kFile, atlas_point_list("LPS", true))}}));
+}
+
+TEST(ImportMarkupsTest, AnUnknownLabelIsRejectedListingTheKnownOnes) {
+  const std::string message = import_error(R"json({"markups": [{"type": "Fiducial",
+    "coordinateSystem": "RAS", "controlPoints": [
+      {"label": "RASIS", "position": [677.4, 491.3, 975.8]},
+      {"label": "greater trochanter", "position": [670.0, 440.0, 860.0]}]}]})json");
+  EXPECT_NE(message.find("'greater trochanter' names no landmark"), std::string::npos) << message;
+  EXPECT_NE(message.find("lateral_epicondyle_r (R Lateral Epicondyle"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("Heel: the most posterior point of the calcaneal tuberosity"),
+            std::string::npos);
+}
+
 TEST(StaticTrialLandmarksTest, RealStaticTrialGivesAPlausibleFemurLength) {
   test::NodeHarness harness;
   const auto trial = harness.add_file(

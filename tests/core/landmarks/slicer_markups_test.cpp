@@ -37,7 +37,7 @@ constexpr const char* kSlicerFile = R"({
          "positionStatus": "defined"},
         {"id": "3", "label": "ankle", "position": [0.0, 0.0, 0.0],
          "positionStatus": "undefined"},
-        {"id": "4", "label": "lesser trochanter", "position": [-70.0, -5.0, 820.0],
+        {"id": "4", "label": "R Knee Lat", "position": [-70.0, -5.0, 500.0],
          "positionStatus": "defined"}
       ],
       "measurements": [],
@@ -66,17 +66,33 @@ TEST(SlicerMarkupsTest, ReadsAPointListInLpsAsRas) {
   EXPECT_EQ(set.frame, "patient");
   EXPECT_EQ(set.source, "slicer_markups");
   ASSERT_THAT(set.names(),
-              ElementsAre("femoral_head_centre_r", "patella_centre_r", "lesser trochanter"));
+              ElementsAre("femoral_head_centre_r", "patella_centre_r", "lateral_epicondyle_r"));
+  EXPECT_EQ(result.coordinate_system, "LPS");
   // LPS -> RAS: x and y change sign, z stays.
   EXPECT_EQ(set.landmarks[0].position_mm, Eigen::Vector3d(90.5, -10.25, 900.0));
   EXPECT_EQ(set.landmarks[1].position_mm, Eigen::Vector3d(80.0, 30.0, 480.0));
-  // Notes: the renamed label, the undefined point, the unmatched label, the line.
+  // Notes: the renamed labels, the undefined point, the line.
   ASSERT_EQ(result.notes.size(), 4U);
   EXPECT_THAT(result.notes[0], HasSubstr("label 'Patella Center R' read as 'patella_centre_r'"));
   EXPECT_THAT(result.notes[1],
               AllOf(HasSubstr("markups[0].controlPoints[2] ('ankle')"), HasSubstr("undefined")));
-  EXPECT_THAT(result.notes[2], HasSubstr("'lesser trochanter' matches no landmark name"));
+  EXPECT_THAT(result.notes[2], HasSubstr("label 'R Knee Lat' read as 'lateral_epicondyle_r'"));
   EXPECT_THAT(result.notes[3], HasSubstr("markups[1]: markup of type 'Line' ignored"));
+}
+
+TEST(SlicerMarkupsTest, AnUnknownLabelIsAnErrorListingTheKnownLabels) {
+  const test::ScratchDir dir("markups");
+  const auto file = test::write_file(dir / "unknown.mrk.json", R"({"markups": [{
+      "type": "Fiducial", "coordinateSystem": "RAS", "controlPoints": [
+        {"label": "RASIS", "position": [677, 491, 976]},
+        {"label": "lesser trochanter", "position": [620, 440, 820]}]}]})");
+  const std::string message = io_error_of([&] { read_slicer_markups(file); });
+  EXPECT_THAT(message,
+              AllOf(HasSubstr("unknown.mrk.json"), HasSubstr("markups[0].controlPoints[1].label"),
+                    HasSubstr("'lesser trochanter' names no landmark"),
+                    // The table: atlas names, labels and definitions.
+                    HasSubstr("asis_r (R ASIS"), HasSubstr("heel_r ("),
+                    HasSubstr("Lateral femoral epicondyle: the most prominent point")));
 }
 
 TEST(SlicerMarkupsTest, HonoursRasAndUnits) {
@@ -105,6 +121,8 @@ TEST(SlicerMarkupsTest, LabelsMatchExactlyThenLooselyThenByAlias) {
   EXPECT_EQ(match_landmark_name("femoral head"), "femoral_head_centre_r");
   EXPECT_EQ(match_landmark_name("Femoral head right"), "femoral_head_centre_r");
   EXPECT_EQ(match_landmark_name("Ankle Center"), "ankle_centre_r");
+  EXPECT_EQ(match_landmark_name("RASIS"), "asis_r");
+  EXPECT_EQ(match_landmark_name("V Sacral"), "sacral_point");
   EXPECT_EQ(match_landmark_name("F-1"), "");
   EXPECT_EQ(match_landmark_name("  "), "");
   MarkupsReadOptions options;
@@ -146,7 +164,7 @@ TEST(SlicerMarkupsTest, ErrorsNameTheFileAndJsonPath) {
   };
   const std::string path = (dir / "bad.mrk.json").string();
   EXPECT_THAT(error_for(R"({"markups": [{"type": "Fiducial", "controlPoints": [
-                  {"label": "a", "position": [1, 2, 3]}, {"label": "b", "position": [1, 2]}]}]})"),
+                  {"label": "ankle", "position": [1, 2, 3]}, {"label": "b", "position": [1, 2]}]}]})"),
               AllOf(HasSubstr(path + ": markups[0].controlPoints[1].position"),
                     HasSubstr("must be 3 finite numbers, got [1,2]")));
   EXPECT_THAT(error_for(R"({"markups": [{"type": "Fiducial", "coordinateSystem": "XYZ"}]})"),
