@@ -180,7 +180,7 @@ def correct_patella(args, demo):
         fail("the correction was refused: " + submitted.stdout + submitted.stderr)
     after = execution_ids(status(args, study))
     rerun = sorted(n for n in before if after[n] != before[n])
-    expected = ["fibres", "hulls", "landmarks", "motion", "scaled", "wrap"]
+    expected = ["fibres", "hulls", "landmarks", "motion", "outlines", "scaled", "wrap"]
     if rerun != expected:
         fail(f"after the correction these nodes have new results: {rerun}; expected {expected}")
     report = subprocess.run([str(args.mmm), "report", str(study)], capture_output=True, text=True)
