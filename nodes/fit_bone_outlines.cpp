@@ -1,6 +1,7 @@
 #include "nodes/fit_bone_outlines.h"
 
 #include <chrono>
+#include <cmath>
 #include <string>
 
 #include "core/atlas/atlas_io.h"
@@ -61,7 +62,7 @@ nlohmann::json fit_report(const outlines::AtlasOutlineFit& fit) {
     // Where the images do not decide the shape, the scaled atlas's holds.
     if (bone.held_by_prior > 0.25) {
       entry["note"] = "the images determine little of this bone (" +
-                      std::to_string(static_cast<int>(100 * bone.held_by_prior + 0.5)) +
+                      std::to_string(std::lround(100 * bone.held_by_prior)) +
                       " % of its surface held by the prior: superimposed or seen edge-on)";
     }
     bones.push_back(entry);

@@ -1,5 +1,6 @@
 #include "core/atlas/bone_set.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <fstream>
 #include <iomanip>

@@ -77,11 +77,10 @@ BoneSetPatientReport make_bone_set_patient(const BoneSet& set,
     if (atlas.find_bone(name) == nullptr) {
       std::string known;
       for (const Bone& bone : atlas.bones) known += (known.empty() ? "" : ", ") + bone.name;
-      throw InvalidInputError("bone set " + set.source + ": '" + name +
-                              "' is not a bone of atlas " + atlas.name +
-                              "; hint: name the bones "
-                              "as the atlas does (" +
-                              known + ")");
+      std::string message = "bone set " + set.source + ": '" + name;
+      message += "' is not a bone of atlas " + atlas.name;
+      message += "; hint: name the bones as the atlas does (" + known + ")";
+      throw InvalidInputError(message);
     }
     try {
       mesh::validate_indices_and_coordinates(surface);

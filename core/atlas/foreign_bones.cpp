@@ -1,5 +1,6 @@
 #include "core/atlas/foreign_bones.h"
 
+#include <array>
 #include <cmath>
 
 #include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
@@ -22,13 +23,18 @@ struct ForeignBone {
   bool refine;  // one bone in both models: refined by ICP
 };
 
-constexpr ForeignBone kGait2392Bones[] = {
-    {"pelvis.vtp", "pelvis", true},       {"l_pelvis.vtp", "pelvis_l", true},
-    {"sacrum.vtp", "sacrum", true},       {"femur_r.vtp", "femur_r", true},
-    {"patella_r.vtp", "patella_r", true}, {"tibia_r.vtp", "tibia_r", true},
-    {"fibula.vtp", "fibula_r", true},     {"talus.vtp", "talus_r", true},
-    {"foot.vtp", "calcn_r", false},       {"bofoot.vtp", "toes_r", false},
-};
+constexpr std::array<ForeignBone, 10> kGait2392Bones = {{
+    {"pelvis.vtp", "pelvis", true},
+    {"l_pelvis.vtp", "pelvis_l", true},
+    {"sacrum.vtp", "sacrum", true},
+    {"femur_r.vtp", "femur_r", true},
+    {"patella_r.vtp", "patella_r", true},
+    {"tibia_r.vtp", "tibia_r", true},
+    {"fibula.vtp", "fibula_r", true},
+    {"talus.vtp", "talus_r", true},
+    {"foot.vtp", "calcn_r", false},
+    {"bofoot.vtp", "toes_r", false},
+}};
 
 // Two Loop subdivisions: the model's facets (a tibia of 286 triangles) smoothed
 // into a surface like a segmented bone's. Open or non-manifold surfaces (the

@@ -64,7 +64,7 @@ std::array<image::RadiographView, 2> write_patient_radiographs(
   const Eigen::Vector3d size = box.sizes();
   geometry.field_width_mm = std::max(size.x(), size.y()) + 2 * options.field_margin_mm;
   geometry.field_height_mm = size.z() + 2 * options.field_margin_mm;
-  const std::array<image::RadiographView, 2> views = image::make_biplanar_views(geometry);
+  std::array<image::RadiographView, 2> views = image::make_biplanar_views(geometry);
 
   std::vector<std::unique_ptr<mesh::AabbTree>> trees;
   std::vector<image::AttenuatingMesh> materials;

@@ -176,7 +176,9 @@ std::string landmark_label_table_text() {
     std::string examples;
     const std::string side = entry.side == "right" ? "R" : entry.side == "left" ? "L" : "";
     for (const std::string& label : entry.labels) {
-      examples += (examples.empty() ? "" : ", ") + (side.empty() ? label : side + " " + label);
+      if (!examples.empty()) examples += ", ";
+      if (!side.empty()) examples.append(side).append(" ");
+      examples += label;
     }
     out += "  " + entry.name + " (" + examples + "): " + entry.definition + "\n";
   }

@@ -65,6 +65,7 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
   }
   const std::vector<image::RadiographView> views = pair.calibrated_views();
   std::vector<std::string> view_names;
+  view_names.reserve(views.size());
   for (const image::RadiographView& view : views) view_names.push_back(view.name);
   for (const OutlineCorrection& correction : corrections) {
     if (std::ranges::find(options.bones, correction.bone) == options.bones.end()) {

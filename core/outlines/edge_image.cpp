@@ -15,9 +15,10 @@ image::FloatImage blurred(const image::GrayImage16& in, double sigma) {
   const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma)));
   std::vector<float> kernel(static_cast<std::size_t>(2 * radius + 1));
   double total = 0.0;
-  for (int k = -radius; k <= radius; ++k) {
+  for (std::size_t i = 0; i < kernel.size(); ++i) {
+    const double k = static_cast<double>(i) - radius;
     const double w = std::exp(-0.5 * k * k / (sigma * sigma));
-    kernel[static_cast<std::size_t>(k + radius)] = static_cast<float>(w);
+    kernel[i] = static_cast<float>(w);
     total += w;
   }
   for (float& w : kernel) w = static_cast<float>(w / total);
@@ -27,9 +28,9 @@ image::FloatImage blurred(const image::GrayImage16& in, double sigma) {
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       float sum = 0.0F;
-      for (int k = -radius; k <= radius; ++k) {
-        const int xx = std::clamp(x + k, 0, w - 1);
-        sum += kernel[static_cast<std::size_t>(k + radius)] * static_cast<float>(in.at(xx, y));
+      for (std::size_t i = 0; i < kernel.size(); ++i) {
+        const int xx = std::clamp(x + static_cast<int>(i) - radius, 0, w - 1);
+        sum += kernel[i] * static_cast<float>(in.at(xx, y));
       }
       rows.at(x, y) = sum;
     }
@@ -38,9 +39,9 @@ image::FloatImage blurred(const image::GrayImage16& in, double sigma) {
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       float sum = 0.0F;
-      for (int k = -radius; k <= radius; ++k) {
-        const int yy = std::clamp(y + k, 0, h - 1);
-        sum += kernel[static_cast<std::size_t>(k + radius)] * rows.at(x, yy);
+      for (std::size_t i = 0; i < kernel.size(); ++i) {
+        const int yy = std::clamp(y + static_cast<int>(i) - radius, 0, h - 1);
+        sum += kernel[i] * rows.at(x, yy);
       }
       out.at(x, y) = sum;
     }
@@ -102,19 +103,22 @@ std::optional<EdgeImage::Edge> EdgeImage::edge_along(const Eigen::Vector2d& p,
   constexpr double kStep = 0.5;
   const int steps = std::max(1, static_cast<int>(std::ceil(reach_px / kStep)));
   std::vector<double> fall(static_cast<std::size_t>(2 * steps + 1));
+  // Index of offset k (in steps, -steps..steps) in `fall`.
+  const auto at = [steps](int k) {
+    const int index = k + steps;
+    return static_cast<std::size_t>(index);
+  };
   for (int k = -steps; k <= steps; ++k) {
     const double s = k * kStep;
-    fall[static_cast<std::size_t>(k + steps)] =
-        -(sample(p + (s + kStep) * n) - sample(p + (s - kStep) * n)) / (2 * kStep);
+    fall[at(k)] = -(sample(p + (s + kStep) * n) - sample(p + (s - kStep) * n)) / (2 * kStep);
   }
   const double prior_sigma = std::max(reach_px * nearness, 1.0);
   std::optional<int> best;
   double best_score = 0.0;
   for (int k = -steps + 1; k <= steps - 1; ++k) {
-    const double f = fall[static_cast<std::size_t>(k + steps)];
+    const double f = fall[at(k)];
     if (f < min_fall) continue;
-    if (f < fall[static_cast<std::size_t>(k + steps - 1)] ||
-        f < fall[static_cast<std::size_t>(k + steps + 1)]) {
+    if (f < fall[at(k - 1)] || f < fall[at(k + 1)]) {
       continue;  // not a local peak
     }
     const double s = k * kStep;
@@ -125,9 +129,9 @@ std::optional<EdgeImage::Edge> EdgeImage::edge_along(const Eigen::Vector2d& p,
     }
   }
   if (!best) return std::nullopt;
-  const double a = fall[static_cast<std::size_t>(*best + steps - 1)];
-  const double b = fall[static_cast<std::size_t>(*best + steps)];
-  const double c = fall[static_cast<std::size_t>(*best + steps + 1)];
+  const double a = fall[at(*best - 1)];
+  const double b = fall[at(*best)];
+  const double c = fall[at(*best + 1)];
   const double curvature = a - 2 * b + c;
   const double shift = curvature < 0 ? std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5) : 0.0;
   return Edge{(*best + shift) * kStep + edge_shift_px_, b};

@@ -249,7 +249,7 @@ void measure_stretch(BoneScaling& bone, const Eigen::Matrix3d& first_stage, cons
     if (gradient.isZero(0.0)) continue;
     const Eigen::JacobiSVD<Eigen::Matrix3d> svd((bone.affine.linear() + gradient) * first_inverse,
                                                 Eigen::ComputeFullU);
-    const Vector3d sigma = svd.singularValues();
+    const Vector3d& sigma = svd.singularValues();
     if (sigma[0] > highest) {
       highest = sigma[0];
       high_direction = svd.matrixU().col(0);

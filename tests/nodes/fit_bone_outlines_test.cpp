@@ -81,7 +81,8 @@ struct Fixture {
     params["bones"] = std::string("femur_r, tibia_r, fibula_r");
   }
 
-  double femur_error(const workflow::ArtifactRef& atlas, const std::string& name) {
+  [[nodiscard]] double femur_error(const workflow::ArtifactRef& atlas,
+                                   const std::string& name) const {
     const std::filesystem::path out = harness.folder() / name;
     unpack_directory(mmm::test::read_text(atlas.path), out, "output");
     const atlas::Atlas patient = atlas::read_atlas(out);
