@@ -304,31 +304,6 @@ class Painter {
   std::vector<std::size_t> touched_;
 };
 
-// Projections (pixels) of the vertices used by faces; throws for a vertex on
-// or behind the source plane.
-std::vector<Eigen::Vector2d> project_vertices(const RadiographView& view,
-                                              const mesh::IndexedMesh& surface,
-                                              const std::string& label) {
-  const double sign = view.P.leftCols<3>().determinant() > 0 ? 1.0 : -1.0;
-  std::vector<bool> used(static_cast<std::size_t>(surface.V.rows()), false);
-  for (Eigen::Index f = 0; f < surface.F.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) used[static_cast<std::size_t>(surface.F(f, k))] = true;
-  }
-  std::vector<Eigen::Vector2d> pixels(used.size(), Eigen::Vector2d::Zero());
-  for (Eigen::Index v = 0; v < surface.V.rows(); ++v) {
-    if (!used[static_cast<std::size_t>(v)]) continue;
-    const Eigen::Vector3d p = surface.V.row(v).transpose();
-    const Eigen::Vector3d h = view.P * p.homogeneous();
-    if (!(sign * h.z() > 0)) {
-      throw InvalidInputError("outline_overlay: view '" + view.name + "': " + label + ": vertex " +
-                              std::to_string(v) + " " + format_point(p) +
-                              " lies on or behind the source plane (wrong frame or units?)");
-    }
-    pixels[static_cast<std::size_t>(v)] = h.hnormalized();
-  }
-  return pixels;
-}
-
 void draw_legend(RgbImage8& image, std::span<const OutlineItem> items) {
   int left = kLegendMargin;
   int top = kLegendMargin;
@@ -356,7 +331,7 @@ void draw_view(const RadiographView& view, RgbImage8& canvas, std::span<const Ou
     const mesh::IndexedMesh& surface = *items[k].mesh;
     if (surface.empty()) continue;
     const std::vector<Eigen::Vector2d> pixels =
-        project_vertices(view, surface, item_label(items, k));
+        project_face_vertices(view, surface, "outline_overlay: " + item_label(items, k));
     const std::vector<std::array<int, 2>> edges =
         keep_contour_pieces(silhouette_edges(surface, view.source_mm), options.min_contour_edges);
     for (const auto& [a, b] : edges) {

@@ -11,29 +11,6 @@
 namespace mmm::image {
 namespace {
 
-// Pixel of every vertex used by a face (zero for the others); throws for a
-// vertex on or behind the source plane.
-std::vector<Eigen::Vector2d> silhouette_pixels(const RadiographView& view,
-                                               const mesh::IndexedMesh& surface) {
-  const double sign = view.P.leftCols<3>().determinant() > 0 ? 1.0 : -1.0;
-  std::vector<bool> used(static_cast<std::size_t>(surface.V.rows()), false);
-  for (Eigen::Index f = 0; f < surface.F.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) used[static_cast<std::size_t>(surface.F(f, k))] = true;
-  }
-  std::vector<Eigen::Vector2d> pixels(used.size(), Eigen::Vector2d::Zero());
-  for (Eigen::Index v = 0; v < surface.V.rows(); ++v) {
-    if (!used[static_cast<std::size_t>(v)]) continue;
-    const Eigen::Vector3d h = view.P * surface.V.row(v).transpose().homogeneous();
-    if (!(sign * h.z() > 0)) {
-      throw InvalidInputError("silhouette_polylines: view '" + view.name + "': vertex " +
-                              std::to_string(v) +
-                              " lies on or behind the source plane (wrong frame or units?)");
-    }
-    pixels[static_cast<std::size_t>(v)] = h.hnormalized();
-  }
-  return pixels;
-}
-
 // The edges chained into vertex paths: first the open chains, each from a
 // vertex of degree != 2 (in edge order), then the closed loops (first vertex
 // repeated at the end).
@@ -81,6 +58,30 @@ std::vector<std::vector<int>> chain_edges(const std::vector<std::array<int, 2>>&
 }
 
 }  // namespace
+
+std::vector<Eigen::Vector2d> project_face_vertices(const RadiographView& view,
+                                                   const mesh::IndexedMesh& surface,
+                                                   const std::string& what) {
+  const double sign = view.P.leftCols<3>().determinant() > 0 ? 1.0 : -1.0;
+  std::vector<bool> used(static_cast<std::size_t>(surface.V.rows()), false);
+  for (Eigen::Index f = 0; f < surface.F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) used[static_cast<std::size_t>(surface.F(f, k))] = true;
+  }
+  std::vector<Eigen::Vector2d> pixels(used.size(), Eigen::Vector2d::Zero());
+  for (Eigen::Index v = 0; v < surface.V.rows(); ++v) {
+    if (!used[static_cast<std::size_t>(v)]) continue;
+    const Eigen::Vector3d p = surface.V.row(v).transpose();
+    const Eigen::Vector3d h = view.P * p.homogeneous();
+    if (!(sign * h.z() > 0)) {
+      throw InvalidInputError(what + ": view '" + view.name + "': vertex " + std::to_string(v) +
+                              " (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " +
+                              std::to_string(p.z()) +
+                              ") lies on or behind the source plane (wrong frame or units?)");
+    }
+    pixels[static_cast<std::size_t>(v)] = h.hnormalized();
+  }
+  return pixels;
+}
 
 std::vector<std::array<int, 2>> silhouette_edges(const mesh::IndexedMesh& surface,
                                                  const Eigen::Vector3d& source) {
@@ -169,7 +170,8 @@ std::vector<Polyline2d> silhouette_polylines(const mesh::IndexedMesh& surface,
   mesh::validate_indices_and_coordinates(surface);
   std::vector<Polyline2d> polylines;
   if (surface.F.rows() == 0) return polylines;
-  const std::vector<Eigen::Vector2d> pixels = silhouette_pixels(view, surface);
+  const std::vector<Eigen::Vector2d> pixels =
+      project_face_vertices(view, surface, "silhouette_polylines");
   const std::vector<std::array<int, 2>> edges =
       keep_contour_pieces(silhouette_edges(surface, view.source_mm), min_contour_edges);
   for (const std::vector<int>& chain : chain_edges(edges)) {

@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <string>
 #include <vector>
 
 #include "core/image/projection.h"
@@ -39,6 +40,13 @@ std::vector<std::array<int, 2>> silhouette_edges(const mesh::IndexedMesh& surfac
 // min_edges <= 1.
 std::vector<std::array<int, 2>> keep_contour_pieces(const std::vector<std::array<int, 2>>& edges,
                                                     int min_edges);
+
+// The pixel of every vertex used by a face (zero for the others). Throws
+// InvalidInputError, starting with `what`, naming the view and the vertex,
+// for a vertex on or behind the source plane.
+std::vector<Eigen::Vector2d> project_face_vertices(const RadiographView& view,
+                                                   const mesh::IndexedMesh& surface,
+                                                   const std::string& what);
 
 // A polyline in pixel coordinates (u right, v down, pixel centres at +0.5).
 using Polyline2d = std::vector<Eigen::Vector2d>;
