@@ -15,12 +15,10 @@
 namespace mmm::image {
 namespace {
 
-using Json = nlohmann::json;
-
 constexpr const char* kCorrectionsFormat = "mmm-outline-corrections";
 constexpr int kCorrectionsVersion = 1;
 
-std::string short_json(const Json& value) {
+std::string short_json(const nlohmann::json& value) {
   std::string text = value.dump();
   constexpr std::size_t kMax = 60;
   if (text.size() > kMax) text = text.substr(0, kMax) + "...";
@@ -42,7 +40,7 @@ class CorrectionsReader {
     throw InvalidInputError(source_ + ": " + (where.empty() ? "" : where + ": ") + problem);
   }
 
-  void only_fields(const Json& object, const std::string& where,
+  void only_fields(const nlohmann::json& object, const std::string& where,
                    std::initializer_list<const char*> known) const {
     for (auto it = object.begin(); it != object.end(); ++it) {
       const std::string& key = it.key();
@@ -57,14 +55,15 @@ class CorrectionsReader {
     }
   }
 
-  const Json& field(const Json& object, const std::string& where, const char* key) const {
+  const nlohmann::json& field(const nlohmann::json& object, const std::string& where,
+                              const char* key) const {
     const auto it = object.find(key);
     if (it == object.end()) fail(where, std::string("field '") + key + "' is missing");
     return *it;
   }
 
-  std::string text(const Json& object, const std::string& where, const char* key) const {
-    const Json& value = field(object, where, key);
+  std::string text(const nlohmann::json& object, const std::string& where, const char* key) const {
+    const nlohmann::json& value = field(object, where, key);
     if (!value.is_string() || value.get<std::string>().empty()) {
       fail(where,
            std::string("field '") + key + "' must be a non-empty string, got " + short_json(value));
@@ -72,7 +71,7 @@ class CorrectionsReader {
     return value.get<std::string>();
   }
 
-  std::string hash(const Json& object, const char* key) const {
+  std::string hash(const nlohmann::json& object, const char* key) const {
     std::string value = text(object, "", key);
     if (!is_artifact_hash(value)) {
       fail(key, "must be an artifact hash (64 lowercase hex digits), got '" + value + "'");
@@ -80,13 +79,13 @@ class CorrectionsReader {
     return value;
   }
 
-  OutlineCorrection correction(const Json& entry, const std::string& where) const {
+  OutlineCorrection correction(const nlohmann::json& entry, const std::string& where) const {
     if (!entry.is_object()) fail(where, "must be an object {bone, view, points_px}");
     only_fields(entry, where, {"bone", "view", "points_px"});
     OutlineCorrection out;
     out.bone = text(entry, where, "bone");
     out.view = text(entry, where, "view");
-    const Json& points = field(entry, where, "points_px");
+    const nlohmann::json& points = field(entry, where, "points_px");
     if (!points.is_array() || points.empty()) {
       fail(where + ".points_px", "must be a non-empty list of [u, v] pixel positions");
     }
@@ -95,7 +94,7 @@ class CorrectionsReader {
                                      std::to_string(kMaxPointsPerCorrection) + " are allowed");
     }
     for (std::size_t k = 0; k < points.size(); ++k) {
-      const Json& uv = points[k];
+      const nlohmann::json& uv = points[k];
       const bool pair = uv.is_array() && uv.size() == 2 && uv[0].is_number() && uv[1].is_number();
       const Eigen::Vector2d p = pair ? Eigen::Vector2d(uv[0].get<double>(), uv[1].get<double>())
                                      : Eigen::Vector2d::Zero();
@@ -108,15 +107,15 @@ class CorrectionsReader {
     return out;
   }
 
-  OutlineCorrections corrections(const Json& root) const {
+  OutlineCorrections corrections(const nlohmann::json& root) const {
     if (!root.is_object()) fail("", "must be a JSON object");
     only_fields(root, "", {"format", "version", "decision", "corrections", "radiographs", "atlas"});
-    const Json& format = field(root, "", "format");
+    const nlohmann::json& format = field(root, "", "format");
     if (format != kCorrectionsFormat) {
       fail("format",
            std::string("must be \"") + kCorrectionsFormat + "\", got " + short_json(format));
     }
-    const Json& version = field(root, "", "version");
+    const nlohmann::json& version = field(root, "", "version");
     if (!version.is_number_integer() || version.get<std::int64_t>() != kCorrectionsVersion) {
       fail("version", "must be 1 (this mmm reads version 1), got " + short_json(version));
     }
@@ -129,7 +128,7 @@ class CorrectionsReader {
     } else {
       fail("decision", R"(must be "accept" or "correct", got ")" + decision + "\"");
     }
-    const Json& list = field(root, "", "corrections");
+    const nlohmann::json& list = field(root, "", "corrections");
     if (!list.is_array()) fail("corrections", "must be a list, got " + short_json(list));
     std::size_t total = 0;
     for (std::size_t k = 0; k < list.size(); ++k) {
@@ -175,13 +174,13 @@ void sort_outline_corrections(OutlineCorrections& corrections) {
 }
 
 std::string outline_corrections_to_json_text(const OutlineCorrections& corrections) {
-  Json list = Json::array();
+  nlohmann::json list = nlohmann::json::array();
   for (const OutlineCorrection& correction : corrections.corrections) {
-    Json points = Json::array();
+    nlohmann::json points = nlohmann::json::array();
     for (const Eigen::Vector2d& p : correction.points_px) points.push_back({p.x(), p.y()});
     list.push_back({{"bone", correction.bone}, {"view", correction.view}, {"points_px", points}});
   }
-  const Json root = {
+  const nlohmann::json root = {
       {"format", kCorrectionsFormat},
       {"version", kCorrectionsVersion},
       {"decision", corrections.decision == OutlineDecision::kAccept ? "accept" : "correct"},
@@ -195,10 +194,10 @@ std::string outline_corrections_to_json_text(const OutlineCorrections& correctio
 
 OutlineCorrections read_outline_corrections(std::string_view text, std::string_view source) {
   const CorrectionsReader reader(source);
-  Json root;
+  nlohmann::json root;
   try {
     root = parse_json(text);
-  } catch (const Json::parse_error& error) {
+  } catch (const nlohmann::json::parse_error& error) {
     reader.fail(
         "", std::string("not valid JSON (NaN and Infinity are not JSON numbers): ") + error.what());
   }
