@@ -74,4 +74,12 @@ void write_file_atomically(const fs::path& path, std::string_view bytes, std::st
   }
 }
 
+void replace_directory(const std::filesystem::path& staged, const std::filesystem::path& target) {
+  const std::filesystem::path previous = target.string() + ".previous";
+  std::filesystem::remove_all(previous);
+  if (std::filesystem::exists(target)) std::filesystem::rename(target, previous);
+  std::filesystem::rename(staged, target);
+  std::filesystem::remove_all(previous);
+}
+
 }  // namespace mmm

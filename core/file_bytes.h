@@ -23,4 +23,11 @@ std::string read_file_bytes(const std::filesystem::path& path, std::uintmax_t si
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
                            std::string_view kind = "a file");
 
+// Puts the folder `staged` (complete) where `target` is: the old target is
+// renamed aside, the staged one renamed in, the old one removed. A crash
+// leaves either the old folder or the new one under `target`, never half of
+// one (and at worst the old one beside it as "<target>.previous", removed by
+// the next call). Throws std::filesystem::filesystem_error on failure.
+void replace_directory(const std::filesystem::path& staged, const std::filesystem::path& target);
+
 }  // namespace mmm

@@ -198,10 +198,13 @@ void FitBoneOutlines::run(workflow::NodeContext& context) {
   context.progress(2, 5, "carrying muscles and derived elements");
   scaling::AtlasScalingOptions carry;
   carry.threads = options.threads;
-  const auto prepared = scaling::prepare_atlas(scaled, meshes, carry);
+  // The scaled atlas moves into the preparation; it is read from there on.
+  const auto prepared = scaling::prepare_atlas(std::move(scaled), std::move(meshes), carry);
+  const atlas::Atlas& start = prepared->atlas;
+  const atlas::AtlasMeshes& start_meshes = prepared->meshes;
   scaling::BonePlacement placement;
-  for (const atlas::Bone& bone : scaled.bones) {
-    placement.vertices[bone.name] = meshes.at(bone.name).at("full").V;
+  for (const atlas::Bone& bone : start.bones) {
+    placement.vertices[bone.name] = start_meshes.at(bone.name).at("full").V;
     placement.affine[bone.name] = Eigen::Affine3d::Identity();
   }
   for (const outlines::BoneOutlineFit& bone : fit.bones) {
@@ -233,7 +236,7 @@ void FitBoneOutlines::run(workflow::NodeContext& context) {
   context.set_output("report", report.dump(2));
   context.progress(4, 5, "drawing the overlay");
   const std::filesystem::path overlay = context.scratch_dir() / "overlay.png";
-  image::write_png(overlay_picture(scaled, meshes, carried.meshes, fit, pair), overlay);
+  image::write_png(overlay_picture(start, start_meshes, carried.meshes, fit, pair), overlay);
   context.set_output_file("overlay", overlay);
   context.progress(5, 5, "done");
 }

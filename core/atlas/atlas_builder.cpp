@@ -20,6 +20,7 @@
 #include "core/atlas/surface_line.h"
 #include "core/atlas/wrap_surfaces.h"
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "core/fit/sphere_fit.h"
 #include "core/mesh/aabb_tree.h"
 #include "core/mesh/decimate.h"
@@ -840,11 +841,7 @@ AtlasBuildReport Builder::run(const std::filesystem::path& out_dir) {
   std::filesystem::remove_all(partial);
   std::filesystem::create_directories(partial);
   write(partial);
-  const std::filesystem::path previous = out_dir.string() + ".previous";
-  std::filesystem::remove_all(previous);
-  if (std::filesystem::exists(out_dir)) std::filesystem::rename(out_dir, previous);
-  std::filesystem::rename(partial, out_dir);
-  std::filesystem::remove_all(previous);
+  replace_directory(partial, out_dir);
   // One note per fact (a muscle with three action lines meets the same bone
   // three times).
   std::vector<std::string> notes;

@@ -8,6 +8,7 @@
 #include "core/atlas/atlas_io.h"
 #include "core/atlas/bone_registration.h"
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "core/fit/sphere_fit.h"
 #include "core/mesh/aabb_tree.h"
 #include "core/mesh/io/mesh_io.h"
@@ -169,11 +170,7 @@ BoneSetPatientReport make_bone_set_patient(const BoneSet& set,
     out << truth.dump(2) << '\n';
     if (!out) throw IoError(partial / "ground_truth.json", "cannot write");
   }
-  const std::filesystem::path previous = out_dir.string() + ".previous";
-  std::filesystem::remove_all(previous);
-  if (std::filesystem::exists(out_dir)) std::filesystem::rename(out_dir, previous);
-  std::filesystem::rename(partial, out_dir);
-  std::filesystem::remove_all(previous);
+  replace_directory(partial, out_dir);
 
   report.bones = static_cast<int>(set.bones.size());
   report.frontal_width = views[0].width;

@@ -13,6 +13,7 @@
 #include "core/atlas/patient_radiographs.h"
 #include "core/atlas/structure_carriage.h"
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "core/image/mesh_render.h"
 #include "core/image/png.h"
 #include "core/mesh/aabb_tree.h"
@@ -165,11 +166,7 @@ SyntheticPatientReport make_synthetic_patient(const std::filesystem::path& atlas
     if (!out) throw IoError(partial / "ground_truth.json", "cannot write");
   }
 
-  const std::filesystem::path previous = out_dir.string() + ".previous";
-  std::filesystem::remove_all(previous);
-  if (std::filesystem::exists(out_dir)) std::filesystem::rename(out_dir, previous);
-  std::filesystem::rename(partial, out_dir);
-  std::filesystem::remove_all(previous);
+  replace_directory(partial, out_dir);
 
   SyntheticPatientReport report;
   report.factors = deformation.factors;

@@ -380,7 +380,7 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
   }
   // The operator's points against the final outline.
   const mesh::IndexedMesh final_surface{current, work.F};
-  for (std::size_t v = 0; v < views.size(); ++v) {
+  for (std::size_t v = 0; v < views.size() && !input.corrections.empty(); ++v) {
     std::vector<double> distances;
     const std::vector<ContourPoint> contour = contour_points(final_surface, *views[v].view);
     for (const CorrectionPoint& c : input.corrections) {
