@@ -9,6 +9,13 @@
 // centres) at their true positions, so that what remains is the shape.
 // Table on stdout and in outlines.accuracy.{txt,json} (bench/table.py folds
 // it into build/bench/outlines.json).
+//
+// For studying the fit: MMM_BENCH_OUTLINE_PATIENTS ("foreign_201,local_301")
+// picks patients, MMM_BENCH_OUTLINE_OPTIONS changes settings (see
+// fit_options), MMM_BENCH_OUTLINE_BONES_ONLY renders patients without soft
+// tissue (in outline_patients_bones_only/), MMM_BENCH_OUTLINE_VERBOSE prints
+// each bone's fit, writes the overlays and fitted surfaces and counts the
+// true surface's far vertices by height.
 
 #include <benchmark/benchmark.h>
 

@@ -74,7 +74,6 @@ constexpr int kAffineUnknowns = 12;
 struct Model {
   Vector3d centre = Vector3d::Zero();
   Eigen::VectorXd theta;
-  Eigen::MatrixX3d nodes_t;  // t as #nodes x 3 (view of theta)
 
   [[nodiscard]] Eigen::Matrix3d D() const {
     return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(theta.data());
