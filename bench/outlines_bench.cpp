@@ -170,14 +170,17 @@ outlines::AtlasOutlineFitOptions fit_options() {
     if (key == "spacing") options.fit.node_spacing_mm = value;
     if (key == "smooth") options.fit.smoothness_weight = value;
     if (key == "prior") options.fit.prior_weight = value;
+    if (key == "bending") options.fit.bending_weight = value;
     if (key == "affine") options.fit.affine_weight = value;
     if (key == "robust") options.fit.robust_mm = value;
     if (key == "fall") options.fit.min_fall_factor = value;
     if (key == "neighbours") options.fit.node_neighbours = static_cast<int>(value);
     if (key == "joint") options.joint_pin = value;
     if (key == "nearness") options.fit.nearness = value;
-    if (key == "reach0") options.fit.stages[0].reach_mm = value;
     if (key == "sigma0") options.fit.stages[0].sigma_px = value;
+    if (key.starts_with("sf"))
+      options.fit.stages.at(std::stoul(key.substr(2))).smoothness_factor = value;
+    if (key.starts_with("reach")) options.fit.stages.at(std::stoul(key.substr(5))).reach_mm = value;
   }
   return options;
 }

@@ -31,6 +31,7 @@ outlines::AtlasOutlineFitOptions options_from(const workflow::NodeContext& conte
   options.work_level = context.text("work_level");
   options.fit.node_spacing_mm = context.number("node_spacing_mm");
   options.fit.smoothness_weight = context.number("smoothness_weight");
+  options.fit.bending_weight = context.number("bending_weight");
   options.fit.robust_mm = context.number("robust_mm");
   options.threads = static_cast<int>(context.integer("threads"));
   return options;
@@ -119,8 +120,13 @@ workflow::NodeSpec FitBoneOutlines::spec() {
       .param<double>("node_spacing_mm", d.fit.node_spacing_mm,
                      "Spacing of the deformation field's nodes", {.min = 2, .max = 50}, "mm")
       .param<double>("smoothness_weight", d.fit.smoothness_weight,
-                     "Weight keeping neighbouring nodes' displacements alike",
+                     "Weight keeping neighbouring nodes' displacements alike (first stage; "
+                     "the finer stages use a fifth and a tenth of it)",
                      {.min = 1e-6, .max = 1e6})
+      .param<double>("bending_weight", d.fit.bending_weight,
+                     "Weight keeping each node's displacement that of its neighbours' linear "
+                     "field (local widening is free, dents are not)",
+                     {.min = 0, .max = 1e6})
       .param<double>("robust_mm", d.fit.robust_mm,
                      "Contour residuals beyond this count linearly (Huber)",
                      {.min = 0.05, .max = 20}, "mm")

@@ -68,6 +68,52 @@ NodeWeights node_weights(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d&
   return out;
 }
 
+// A node's displacement against an affine combination of its graph
+// neighbours' that reproduces the node's own position (sum w = 1,
+// sum w n_j = n_i, least-norm w): zero for any displacement field linear in
+// position, so a bone may widen, narrow or shear locally without cost, while a
+// node that moves apart from its surroundings (a spike, a dent) pays.
+struct BendingStencil {
+  int node = 0;
+  std::vector<std::pair<int, double>> neighbours;
+};
+
+std::vector<BendingStencil> bending_stencils(const Eigen::MatrixX3d& nodes,
+                                             const std::vector<std::pair<int, int>>& graph) {
+  std::vector<std::vector<int>> adjacent(static_cast<std::size_t>(nodes.rows()));
+  for (const auto& [i, j] : graph) {
+    adjacent[static_cast<std::size_t>(i)].push_back(j);
+    adjacent[static_cast<std::size_t>(j)].push_back(i);
+  }
+  std::vector<BendingStencil> out;
+  for (Eigen::Index i = 0; i < nodes.rows(); ++i) {
+    const std::vector<int>& around = adjacent[static_cast<std::size_t>(i)];
+    if (around.size() < 2) continue;
+    const auto k = static_cast<Eigen::Index>(around.size());
+    Eigen::MatrixXd A(4, k);
+    double scale = 0.0;
+    for (Eigen::Index c = 0; c < k; ++c) {
+      const Vector3d d =
+          (nodes.row(around[static_cast<std::size_t>(c)]) - nodes.row(i)).transpose();
+      A(0, c) = 1.0;
+      A.block<3, 1>(1, c) = d;
+      scale = std::max(scale, d.squaredNorm());
+    }
+    // Least-norm solution of A w = (1, 0, 0, 0), regularised for flat or
+    // one-sided neighbourhoods (where no exact linear reproduction exists).
+    Eigen::Matrix4d gram = A * A.transpose();
+    gram.diagonal().tail<3>().array() += 1e-3 * scale;
+    gram(0, 0) += 1e-3;
+    const Eigen::VectorXd w = A.transpose() * gram.ldlt().solve(Eigen::Vector4d(1, 0, 0, 0));
+    BendingStencil stencil;
+    stencil.node = static_cast<int>(i);
+    for (Eigen::Index c = 0; c < k; ++c)
+      stencil.neighbours.emplace_back(around[static_cast<std::size_t>(c)], w[c]);
+    out.push_back(std::move(stencil));
+  }
+  return out;
+}
+
 // The unknowns: D (9, row-major), b (3), then t (3 per node).
 constexpr int kAffineUnknowns = 12;
 
@@ -215,6 +261,8 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
     }
   }
 
+  const std::vector<BendingStencil> bending = bending_stencils(nodes, graph);
+
   BoneOutlineFit result;
   result.bone = input.bone;
   result.nodes = node_count;
@@ -332,7 +380,18 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
           Row row;
           row.terms = {{kAffineUnknowns + 3 * i + axis, 1.0},
                        {kAffineUnknowns + 3 * j + axis, -1.0}};
-          row.weight = options.smoothness_weight;
+          row.weight = options.smoothness_weight * settings.smoothness_factor;
+          rows.push_back(std::move(row));
+        }
+      }
+      for (const BendingStencil& stencil : bending) {
+        for (int axis = 0; axis < 3; ++axis) {
+          Row row;
+          row.terms.emplace_back(kAffineUnknowns + 3 * stencil.node + axis, 1.0);
+          for (const auto& [j, w] : stencil.neighbours) {
+            row.terms.emplace_back(kAffineUnknowns + 3 * j + axis, -w);
+          }
+          row.weight = options.bending_weight;
           rows.push_back(std::move(row));
         }
       }
