@@ -171,6 +171,7 @@ outlines::AtlasOutlineFitOptions fit_options() {
     if (key == "smooth") options.fit.smoothness_weight = value;
     if (key == "prior") options.fit.prior_weight = value;
     if (key == "bending") options.fit.bending_weight = value;
+    if (key == "patella" && value != 0) options.bones.emplace_back("patella_r");
     if (key == "affine") options.fit.affine_weight = value;
     if (key == "robust") options.fit.robust_mm = value;
     if (key == "fall") options.fit.min_fall_factor = value;
