@@ -67,8 +67,11 @@ EOT
   stage "SCRIPTED OPERATOR (not a person): landmark clicks from the patient's ground truth + 1.5 px noise"
   # The scripted operator signs in like a person: with its own token, kept
   # in a file only this account can read.
+  # A new token when there is none or when the root no longer knows the
+  # operator (its studies folder was removed for a fresh study).
   token_file=$demo/$operator.token
-  if [[ ! -s $token_file ]]; then
+  if [[ ! -s $token_file ]] ||
+    ! "$mmm" operator list --root "$root" | grep -q "^$operator "; then
     (umask 077 && "$mmm" operator add "$operator" --root "$root" --replace >"$token_file")
   fi
   if [[ $state == open ]]; then
