@@ -171,6 +171,10 @@ outlines::AtlasOutlineFitOptions fit_options() {
     if (key == "smooth") options.fit.smoothness_weight = value;
     if (key == "prior") options.fit.prior_weight = value;
     if (key == "bending") options.fit.bending_weight = value;
+    if (key == "pelvis_membrane") {
+      for (const char* bone : {"pelvis", "pelvis_l", "sacrum"})
+        options.membrane_factor[bone] = value;
+    }
     if (key == "patella" && value != 0) options.bones.emplace_back("patella_r");
     if (key == "affine") options.fit.affine_weight = value;
     if (key == "robust") options.fit.robust_mm = value;

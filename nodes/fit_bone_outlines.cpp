@@ -2,11 +2,14 @@
 
 #include <chrono>
 #include <cmath>
+#include <map>
+#include <sstream>
 #include <string>
 
 #include "core/atlas/atlas_io.h"
 #include "core/atlas/atlas_meshes.h"
 #include "core/directory_bundle.h"
+#include "core/errors.h"
 #include "core/image/outline_corrections.h"
 #include "core/image/outline_overlay.h"
 #include "core/image/png.h"
@@ -25,9 +28,46 @@ std::string bone_list(const std::vector<std::string>& names) {
   return text;
 }
 
+std::string factor_list(const std::map<std::string, double>& factors) {
+  std::string text;
+  for (const auto& [bone, factor] : factors) {
+    std::ostringstream item;
+    item << bone << '=' << factor;
+    text += (text.empty() ? "" : ", ") + item.str();
+  }
+  return text;
+}
+
+// "bone=factor, ..." -> map (the bones are checked against the atlas by the fit).
+std::map<std::string, double> membrane_factors(const std::string& text) {
+  std::map<std::string, double> factors;
+  for (const std::string& item : split_names(text)) {
+    const auto equals = item.find('=');
+    double factor = std::nan("");
+    if (equals != std::string::npos && equals > 0) {
+      try {
+        std::size_t used = 0;
+        const std::string number = item.substr(equals + 1);
+        factor = std::stod(number, &used);
+        if (used != number.size()) factor = std::nan("");
+      } catch (const std::exception&) {
+        factor = std::nan("");
+      }
+    }
+    if (!(factor > 0 && factor <= 1e3)) {
+      throw InvalidInputError("fit_bone_outlines: parameter 'membrane_factors': '" + item +
+                              "' is not BONE=FACTOR with a factor in (0, 1000]; hint: e.g. "
+                              "pelvis=3, sacrum=3");
+    }
+    factors[item.substr(0, equals)] = factor;
+  }
+  return factors;
+}
+
 outlines::AtlasOutlineFitOptions options_from(const workflow::NodeContext& context) {
   outlines::AtlasOutlineFitOptions options;
   options.bones = split_names(context.text("bones"));
+  options.membrane_factor = membrane_factors(context.text("membrane_factors"));
   options.work_level = context.text("work_level");
   options.fit.node_spacing_mm = context.number("node_spacing_mm");
   options.fit.smoothness_weight = context.number("smoothness_weight");
@@ -123,6 +163,10 @@ workflow::NodeSpec FitBoneOutlines::spec() {
                      "Weight keeping neighbouring nodes' displacements alike (first stage; "
                      "the finer stages use a fifth and a tenth of it)",
                      {.min = 1e-6, .max = 1e6})
+      .param<std::string>("membrane_factors", factor_list(d.membrane_factor),
+                          "Per bone, a factor on smoothness_weight (BONE=FACTOR, comma-separated): "
+                          "the hip bones and sacrum, whose outlines cross many other edges, are "
+                          "held stiffer")
       .param<double>("bending_weight", d.fit.bending_weight,
                      "Weight keeping each node's displacement that of its neighbours' linear "
                      "field (local widening is free, dents are not)",
@@ -188,6 +232,15 @@ void FitBoneOutlines::run(workflow::NodeContext& context) {
   });
   if (!absent.empty()) {
     context.warn("bones not in the atlas, not fitted: " + bone_list(absent));
+  }
+  std::vector<std::string> unused;
+  std::erase_if(options.membrane_factor, [&](const auto& entry) {
+    const bool missing = scaled.find_bone(entry.first) == nullptr;
+    if (missing) unused.push_back(entry.first);
+    return missing;
+  });
+  if (!unused.empty()) {
+    context.warn("membrane_factors names bones not in the atlas (ignored): " + bone_list(unused));
   }
   context.progress(1, 5, "fitting the outlines");
   const outlines::AtlasOutlineFit fit =

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <memory>
 
 #include "core/atlas/kinematic_chain.h"
@@ -62,6 +63,12 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
                               "; hint: its bones are " + joined(atlas_bones));
     }
     chosen.push_back(bone);
+  }
+  for (const auto& [name, factor] : options.membrane_factor) {
+    if (!(factor > 0) || !std::isfinite(factor)) {
+      throw InvalidInputError("outline fit: the membrane factor of bone '" + name +
+                              "' is not a positive number; hint: e.g. 3");
+    }
   }
   const std::vector<image::RadiographView> views = pair.calibrated_views();
   std::vector<std::string> view_names;
@@ -130,7 +137,12 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
         input.corrections.push_back({view, point});
       }
     }
-    result.bones[order[k]] = fit_bone_outline(input, fit_views, options.fit);
+    OutlineFitOptions fit = options.fit;
+    if (const auto factor = options.membrane_factor.find(bone.name);
+        factor != options.membrane_factor.end()) {
+      fit.smoothness_weight *= factor->second;
+    }
+    result.bones[order[k]] = fit_bone_outline(input, fit_views, fit);
   });
   result.fit_seconds = seconds_since(start);
   for (const atlas::Bone& bone : atlas.bones) {

@@ -11,6 +11,7 @@
 
 #include "core/atlas/atlas_io.h"
 #include "core/directory_bundle.h"
+#include "core/errors.h"
 #include "core/image/drr.h"
 #include "core/image/outline_corrections.h"
 #include "core/image/png.h"
@@ -143,6 +144,21 @@ TEST(FitBoneOutlinesNodeTest, AnAcceptedReviewPassesTheAtlasThroughAndACorrectio
     }
   }
   EXPECT_TRUE(tibia_corrected) << report.dump(1);
+}
+
+TEST(FitBoneOutlinesNodeTest, AMalformedMembraneFactorIsRejectedNamingTheParameter) {
+  Fixture f;
+  for (const char* text :
+       {"femur_r=abc", "femur_r=-1", "femur_r", "=2", "femur_r=2x", "femur_r=nan"}) {
+    auto params = f.params;
+    params["membrane_factors"] = std::string(text);
+    try {
+      f.harness.run<FitBoneOutlines>(f.inputs, params);
+      ADD_FAILURE() << text << " was accepted";
+    } catch (const InvalidInputError& e) {
+      EXPECT_NE(std::string(e.what()).find("membrane_factors"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace
