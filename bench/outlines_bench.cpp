@@ -186,6 +186,9 @@ outlines::AtlasOutlineFitOptions fit_options() {
     if (key.starts_with("sf"))
       options.fit.stages.at(std::stoul(key.substr(2))).smoothness_factor = value;
     if (key.starts_with("reach")) options.fit.stages.at(std::stoul(key.substr(5))).reach_mm = value;
+    if (key.starts_with("it")) {
+      options.fit.stages.at(std::stoul(key.substr(2))).iterations = static_cast<int>(value);
+    }
   }
   return options;
 }
@@ -262,7 +265,8 @@ Row measure(const Patient& patient) {
       }
       if (std::getenv("MMM_BENCH_OUTLINE_VERBOSE") != nullptr) {
         std::cerr << patient.name << " " << bone << ": nodes " << b.nodes << ", iterations "
-                  << b.iterations << (b.converged ? " converged" : "") << ", moved "
+                  << b.iterations << (b.converged ? " converged" : "") << ", last change "
+                  << b.last_change_mm << " mm (p95 " << b.last_change_p95_mm << "), moved "
                   << b.moved_mean_mm << " / " << b.moved_max_mm << " mm, held " << b.held_by_prior;
         for (const auto& v : b.views) {
           std::cerr << " | " << v.view << " " << v.matched << "/" << v.contour_points << " "

@@ -408,7 +408,11 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
       }
       model.theta = solve_rows(rows, unknowns);
       const Eigen::MatrixX3d next = model.map_all(work.V, work_weights);
-      const double change = (next - current).rowwise().norm().maxCoeff();
+      const Eigen::VectorXd moves = (next - current).rowwise().norm();
+      const double change = moves.maxCoeff();
+      result.last_change_mm = change;
+      result.last_change_p95_mm =
+          percentile(std::vector<double>(moves.data(), moves.data() + moves.size()), 0.95);
       current = next;
       if (change < options.converged_mm) {
         if (last_stage) result.converged = true;

@@ -137,6 +137,8 @@ struct BoneOutlineFit {
   double moved_max_mm = 0.0;
   double held_by_prior = 0.0;  // fraction of the full surface's vertices no contour reached
   bool converged = false;
+  double last_change_mm = 0.0;      // largest vertex move of the last iteration
+  double last_change_p95_mm = 0.0;  // its 95th percentile
   int iterations = 0;
   int nodes = 0;
   std::vector<double> pin_residual_mm;  // per pin, in order
