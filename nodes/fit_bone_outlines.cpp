@@ -247,6 +247,7 @@ void FitBoneOutlines::run(workflow::NodeContext& context) {
   context.progress(1, 5, "fitting the outlines");
   const outlines::AtlasOutlineFit fit =
       outlines::fit_atlas_outlines(scaled, meshes, given, pair, corrections, options);
+  const double pixel_mm = pair.calibrated_views().front().pixel_spacing_mm;
   for (const outlines::BoneOutlineFit& bone : fit.bones) {
     std::string line = bone.bone + ":";
     for (const outlines::ViewFit& view : bone.views) {
@@ -256,7 +257,6 @@ void FitBoneOutlines::run(workflow::NodeContext& context) {
     context.info(line + (bone.converged ? " converged" : " not converged"));
     // Edges searched again every iteration can keep a surface moving by a
     // fraction of a pixel; more than a pixel is worth a look.
-    const double pixel_mm = pair.calibrated_views().front().pixel_spacing_mm;
     if (!bone.converged) {
       const std::string moving = bone.bone + ": the outline fit was still moving at its end (" +
                                  std::to_string(bone.last_change_p95_mm) +

@@ -271,6 +271,7 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
   Eigen::VectorXd support = Eigen::VectorXd::Zero(node_count);
   Eigen::MatrixX3d current = work.V;
   bool first_iteration = true;
+  Eigen::VectorXd last_moves;  // of the work surface's vertices, in the last iteration
   for (std::size_t stage = 0; stage < options.stages.size(); ++stage) {
     const OutlineFitStage& settings = options.stages[stage];
     const bool last_stage = stage + 1 == options.stages.size();
@@ -408,11 +409,8 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
       }
       model.theta = solve_rows(rows, unknowns);
       const Eigen::MatrixX3d next = model.map_all(work.V, work_weights);
-      const Eigen::VectorXd moves = (next - current).rowwise().norm();
-      const double change = moves.maxCoeff();
-      result.last_change_mm = change;
-      result.last_change_p95_mm =
-          percentile(std::vector<double>(moves.data(), moves.data() + moves.size()), 0.95);
+      last_moves = (next - current).rowwise().norm();
+      const double change = last_moves.maxCoeff();
       current = next;
       if (change < options.converged_mm) {
         if (last_stage) result.converged = true;
@@ -421,6 +419,9 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
     }
   }
 
+  result.last_change_mm = last_moves.maxCoeff();
+  result.last_change_p95_mm = percentile(
+      std::vector<double>(last_moves.data(), last_moves.data() + last_moves.size()), 0.95);
   // The full surface, and what the fit did.
   const NodeWeights full_weights = node_weights(full.V, nodes, h, options.node_neighbours);
   result.vertices = model.map_all(full.V, full_weights);
