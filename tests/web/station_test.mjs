@@ -120,6 +120,10 @@ try {
       continue;
     }
     await page.click(`#landmarks li[data-index="${index}"]`);
+    // The active landmark shows its written anatomical definition.
+    const shown = await page.textContent(`#landmarks li[data-index="${index}"] .definition`);
+    assert.ok(landmark.definition && landmark.definition.length > 20, `${landmark.name} has a definition`);
+    assert.equal(shown, landmark.definition, `${landmark.name}: the page shows its definition`);
     for (const view of views) {
       const [u, v] = expected.pixels[view];
       const at = await page.evaluate(([name, pu, pv]) => window.mmmStation.imageToPage(name, pu, pv), [view, u, v]);

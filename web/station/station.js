@@ -477,7 +477,9 @@
         return `<li data-index="${i}" data-name="${escape(l.name)}" class="${i === this.active ? "active" : ""}">` +
           `<span class="swatch" style="background:${colour}"></span><strong>${i + 1}. ${escape(l.label || l.name)}</strong>` +
           `${l.required ? "" : ' <span class="muted">(optional)</span>'}` +
-          `<div class="hint">${escape(l.hint || "")}</div><div class="places">${places}</div></li>`;
+          `<div class="hint">${escape(l.hint || "")}</div>` +
+          (i === this.active && l.definition ? `<div class="definition">${escape(l.definition)}</div>` : "") +
+          `<div class="places">${places}</div></li>`;
       }).join("");
       this.updateButtons();
       for (const view of this.views) view.draw();
