@@ -97,6 +97,7 @@ Patient make_patient(const std::string& kind, std::uint64_t seed) {
   patient.dir =
       out_dir() /
       (std::getenv("MMM_BENCH_OUTLINE_BONES_ONLY") != nullptr ? "outline_patients_bones_only"
+       : std::getenv("MMM_BENCH_OUTLINE_ENVELOPE") != nullptr ? "outline_patients_envelope"
                                                               : "outline_patients") /
       patient.name;
   if (!fs::exists(patient.dir / "ground_truth.json")) {
@@ -108,6 +109,7 @@ Patient make_patient(const std::string& kind, std::uint64_t seed) {
       if (std::getenv("MMM_BENCH_OUTLINE_BONES_ONLY") != nullptr) set.soft_tissue.clear();
       mmm::atlas::PatientRadiographOptions pictures;
       pictures.seed = seed;
+      pictures.soft_tissue_envelope = std::getenv("MMM_BENCH_OUTLINE_ENVELOPE") != nullptr;
       mmm::atlas::make_bone_set_patient(set, atlas_dir(), patient.dir, pictures);
     } else {
       mmm::atlas::SyntheticPatientOptions options;
@@ -182,6 +184,14 @@ outlines::AtlasOutlineFitOptions fit_options() {
     if (key == "neighbours") options.fit.node_neighbours = static_cast<int>(value);
     if (key == "joint") options.joint_pin = value;
     if (key == "nearness") options.fit.nearness = value;
+    if (key == "thick") options.fit.thickness.weight = value;
+    if (key == "thickfrom") options.fit.thickness.first_stage = static_cast<int>(value);
+    if (key == "thickstep") options.fit.thickness.step_mm = value;
+    if (key == "thickmargin") options.fit.thickness.margin_mm = value;
+    if (key == "thickcos") options.fit.thickness.min_cosine = value;
+    if (key == "thickcut") options.fit.thickness.cutoff = value;
+    if (key == "thickrefresh") options.fit.thickness.refresh_gain = value != 0;
+    if (key == "thickrobust") options.fit.thickness.robust_mm = value;
     if (key == "sigma0") options.fit.stages[0].sigma_px = value;
     if (key.starts_with("sf"))
       options.fit.stages.at(std::stoul(key.substr(2))).smoothness_factor = value;

@@ -73,6 +73,7 @@ outlines::AtlasOutlineFitOptions options_from(const workflow::NodeContext& conte
   options.fit.smoothness_weight = context.number("smoothness_weight");
   options.fit.bending_weight = context.number("bending_weight");
   options.fit.robust_mm = context.number("robust_mm");
+  options.fit.thickness.weight = context.number("thickness_weight");
   options.threads = static_cast<int>(context.integer("threads"));
   return options;
 }
@@ -88,6 +89,9 @@ nlohmann::json fit_report(const outlines::AtlasOutlineFit& fit) {
                        {"start_mean_mm", view.start_mean_mm},
                        {"mean_mm", view.mean_mm},
                        {"p95_mm", view.p95_mm},
+                       {"thickness_samples", view.thickness_samples},
+                       {"thickness_mean_mm", view.thickness_mean_mm},
+                       {"thickness_gain", view.thickness_gain},
                        {"corrections", view.corrections},
                        {"correction_mean_mm", view.correction_mean_mm}});
     }
@@ -176,6 +180,11 @@ workflow::NodeSpec FitBoneOutlines::spec() {
       .param<double>("robust_mm", d.fit.robust_mm,
                      "Contour residuals beyond this count linearly (Huber)",
                      {.min = 0.05, .max = 20}, "mm")
+      .param<double>("thickness_weight", d.fit.thickness.weight,
+                     "Weight per sample ray of the bone's brightness inside its outline against "
+                     "the ray's length through the surface (0: outlines only). Needs radiographs "
+                     "whose soft tissue is smooth across the bone, as in a real limb",
+                     {.min = 0, .max = 100})
       .param<std::int64_t>("threads", d.threads, "Worker threads", {.min = 1, .max = 64})
       .output<Atlas>("atlas", "The patient's atlas with the bones fitted to the radiographs")
       .output<Report>("report", "Per bone and view: contour residuals, movement, convergence")

@@ -4,6 +4,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/atlas/limb_envelope.h"
 #include "core/errors.h"
 #include "core/image/mesh_render.h"
 #include "core/image/png.h"
@@ -68,12 +69,26 @@ std::array<image::RadiographView, 2> write_patient_radiographs(
 
   std::vector<std::unique_ptr<mesh::AabbTree>> trees;
   std::vector<image::AttenuatingMesh> materials;
+  const bool envelope = options.soft_tissue_envelope;
   for (const auto& [name, surface] : bones) {
     trees.push_back(std::make_unique<mesh::AabbTree>(surface));
-    materials.push_back({trees.back().get(), options.mu_bone_per_mm});
+    materials.push_back({trees.back().get(), envelope
+                                                 ? options.mu_bone_per_mm - options.mu_soft_per_mm
+                                                 : options.mu_bone_per_mm});
   }
   for (const auto& [name, surface] : soft_tissue) {
     trees.push_back(std::make_unique<mesh::AabbTree>(surface));
+    materials.push_back(
+        {trees.back().get(), envelope ? options.muscle_contrast_per_mm : options.mu_soft_per_mm});
+  }
+  if (envelope) {
+    std::vector<const mesh::IndexedMesh*> inside;
+    inside.reserve(bones.size() + soft_tissue.size());
+    for (const auto& [name, surface] : bones) inside.push_back(&surface);
+    for (const auto& [name, surface] : soft_tissue) inside.push_back(&surface);
+    LimbEnvelopeOptions shape;
+    shape.fat_mm = options.envelope_fat_mm;
+    trees.push_back(std::make_unique<mesh::AabbTree>(limb_envelope(inside, shape)));
     materials.push_back({trees.back().get(), options.mu_soft_per_mm});
   }
   std::filesystem::create_directories(dir);

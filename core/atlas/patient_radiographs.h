@@ -32,6 +32,14 @@ struct PatientRadiographOptions {
   double field_margin_mm = 40.0;
   double mu_bone_per_mm = image::kBoneMuPerMm;
   double mu_soft_per_mm = image::kSoftTissueMuPerMm;
+  // Soft tissue as in a real limb: an envelope around bones and muscles
+  // (limb_envelope.h) filled with tissue at mu_soft, the bones replacing it
+  // (mu_bone - mu_soft), the muscles only muscle_contrast_per_mm above it
+  // (muscle against fat: 0.021 against 0.018 /mm). Off: the soft-tissue
+  // surfaces at mu_soft in air and the bones at mu_bone on top.
+  bool soft_tissue_envelope = false;
+  double muscle_contrast_per_mm = 0.003;
+  double envelope_fat_mm = 8.0;
   image::RadiographOptions radiograph;  // detector noise; its seed is combined with `seed`
   std::uint64_t seed = 1;               // the patient's seed
   int threads = 2;

@@ -7,6 +7,7 @@
 
 #include "core/atlas/kinematic_chain.h"
 #include "core/errors.h"
+#include "core/outlines/bone_cover.h"
 #include "core/parallel_for.h"
 
 namespace mmm::outlines {
@@ -108,6 +109,21 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
           static_cast<std::size_t>(std::ranges::find(sigmas, stage.sigma_px) - sigmas.begin());
       fit_views[v].edges.push_back(images[v * sigmas.size() + s].get());
     }
+  }
+  // Where the bones lie on each view at the start, for the thickness term.
+  std::vector<std::vector<std::uint8_t>> covers(views.size());
+  if (options.fit.thickness.weight > 0) {
+    std::vector<const mesh::IndexedMesh*> surfaces;
+    for (const atlas::Bone& bone : atlas.bones) {
+      const auto levels = meshes.find(bone.name);
+      if (levels == meshes.end()) continue;
+      const auto level = levels->second.find(options.work_level);
+      surfaces.push_back(level != levels->second.end() ? &level->second
+                                                       : &levels->second.at("full"));
+    }
+    parallel_for(views.size(), options.threads,
+                 [&](std::size_t v) { covers[v] = count_cover(surfaces, views[v]); });
+    for (std::size_t v = 0; v < views.size(); ++v) fit_views[v].cover = &covers[v];
   }
   result.images_seconds = seconds_since(start);
 

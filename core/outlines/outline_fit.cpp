@@ -6,21 +6,21 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <map>
 #include <numeric>
 #include <tuple>
 
 #include "core/errors.h"
+#include "core/outlines/bone_cover.h"
 #include "core/outlines/contour_points.h"
+#include "core/outlines/fit_rows.h"
 
 namespace mmm::outlines {
 namespace {
 
 using Eigen::Vector2d;
 using Eigen::Vector3d;
-
-// Sparse weights of the nodes for a set of points: row i lists (node, w).
-using NodeWeights = std::vector<std::vector<std::pair<int, double>>>;
 
 // Node positions: centroids of the vertices in each cell of a grid of pitch h.
 Eigen::MatrixX3d place_nodes(const Eigen::MatrixX3d& vertices, double h) {
@@ -114,9 +114,6 @@ std::vector<BendingStencil> bending_stencils(const Eigen::MatrixX3d& nodes,
   return out;
 }
 
-// The unknowns: D (9, row-major), b (3), then t (3 per node).
-constexpr int kAffineUnknowns = 12;
-
 struct Model {
   Vector3d centre = Vector3d::Zero();
   Eigen::VectorXd theta;
@@ -142,33 +139,7 @@ struct Model {
   }
 };
 
-// One linear equation in theta: sum coefficient * theta[column] = value, weight.
-struct Row {
-  std::vector<std::pair<int, double>> terms;
-  double value = 0.0;
-  double weight = 1.0;
-};
-
-// Adds the coefficients of a . x(theta) for a point with rest position `rest`
-// and node weights `w` (x = rest + D (rest - c) + b + sum w t), scaled by
-// `scale`, to `row`; returns a . rest * scale (the constant part).
-[[nodiscard]] double add_point(Row& row, const Vector3d& a, const Vector3d& rest,
-                               const Vector3d& centre, const std::vector<std::pair<int, double>>& w,
-                               double scale) {
-  const Vector3d offset = rest - centre;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) row.terms.emplace_back(3 * r + c, scale * a[r] * offset[c]);
-    row.terms.emplace_back(9 + r, scale * a[r]);
-  }
-  for (const auto& [node, weight] : w) {
-    for (int r = 0; r < 3; ++r) {
-      row.terms.emplace_back(kAffineUnknowns + 3 * node + r, scale * weight * a[r]);
-    }
-  }
-  return scale * a.dot(rest);
-}
-
-Eigen::VectorXd solve_rows(const std::vector<Row>& rows, int unknowns) {
+Eigen::VectorXd solve_rows(const std::vector<FitRow>& rows, int unknowns) {
   std::vector<Eigen::Triplet<double>> triplets;
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows.size()));
   for (std::size_t r = 0; r < rows.size(); ++r) {
@@ -272,12 +243,20 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
   Eigen::MatrixX3d current = work.V;
   bool first_iteration = true;
   Eigen::VectorXd last_moves;  // of the work surface's vertices, in the last iteration
+  const bool thickness_on = options.thickness.weight > 0;
+  std::vector<BoneCover> own_cover;
+  own_cover.reserve(views.size());
+  for (const FitView& view : views) {
+    own_cover.push_back(thickness_on && view.cover != nullptr ? BoneCover(work, *view.view)
+                                                              : BoneCover());
+  }
+  std::vector<double> gains(views.size(), 0.0);
   for (std::size_t stage = 0; stage < options.stages.size(); ++stage) {
     const OutlineFitStage& settings = options.stages[stage];
     const bool last_stage = stage + 1 == options.stages.size();
     for (int iteration = 0; iteration < settings.iterations; ++iteration) {
       ++result.iterations;
-      std::vector<Row> rows;
+      std::vector<FitRow> rows;
       support.setZero();
       const mesh::IndexedMesh surface{current, work.F};
       for (std::size_t v = 0; v < views.size(); ++v) {
@@ -310,7 +289,7 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
           // n . J x(theta) = n . J x_cur + s*   (in mm: times the spacing)
           const Eigen::Matrix<double, 2, 3> J = projection_jacobian(view, point.position);
           const Vector3d a = (J.transpose() * point.outward) * spacing;
-          Row row;
+          FitRow row;
           const Vector3d rest_a = work.V.row(point.vertex_a).transpose();
           const Vector3d rest_b = work.V.row(point.vertex_b).transpose();
           const auto& wa = work_weights[static_cast<std::size_t>(point.vertex_a)];
@@ -337,7 +316,7 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
           const Vector2d offset = (q - nearest->pixel) * spacing;  // mm
           for (int axis = 0; axis < 2; ++axis) {
             const Vector3d a = J.row(axis).transpose() * spacing;
-            Row row;
+            FitRow row;
             const double fixed =
                 add_point(row, a, work.V.row(nearest->vertex_a).transpose(), model.centre,
                           work_weights[static_cast<std::size_t>(nearest->vertex_a)],
@@ -348,6 +327,20 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
             row.weight = options.correction_weight;
             rows.push_back(std::move(row));
           }
+        }
+        if (thickness_on && static_cast<int>(stage) >= options.thickness.first_stage) {
+          ThicknessView thickness_view{&view, &edges, views[v].cover, &own_cover[v]};
+          if (options.thickness.refresh_gain) gains[v] = 0.0;
+          ThicknessRows thickness = thickness_rows(surface, work.V, work_weights, model.centre,
+                                                   thickness_view, options.thickness, gains[v]);
+          stats.thickness_samples = static_cast<int>(thickness.rows.size());
+          stats.thickness_mean_mm = thickness.residual_mm.empty()
+                                        ? 0.0
+                                        : std::accumulate(thickness.residual_mm.begin(),
+                                                          thickness.residual_mm.end(), 0.0) /
+                                              static_cast<double>(thickness.residual_mm.size());
+          stats.thickness_gain = gains[v];
+          std::ranges::move(thickness.rows, std::back_inserter(rows));
         }
         stats.matched = static_cast<int>(residuals.size());
         if (std::getenv("MMM_DEBUG_FIT") != nullptr) {
@@ -368,7 +361,7 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
       first_iteration = false;
       for (std::size_t p = 0; p < input.pins.size(); ++p) {
         for (int axis = 0; axis < 3; ++axis) {
-          Row row;
+          FitRow row;
           const double fixed = add_point(row, Vector3d::Unit(axis), input.pins[p].rest,
                                          model.centre, pin_weights[p], 1.0);
           row.value = input.pins[p].target[axis] - fixed;
@@ -378,7 +371,7 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
       }
       for (const auto& [i, j] : graph) {
         for (int axis = 0; axis < 3; ++axis) {
-          Row row;
+          FitRow row;
           row.terms = {{kAffineUnknowns + 3 * i + axis, 1.0},
                        {kAffineUnknowns + 3 * j + axis, -1.0}};
           row.weight = options.smoothness_weight * settings.smoothness_factor;
@@ -387,7 +380,7 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
       }
       for (const BendingStencil& stencil : bending) {
         for (int axis = 0; axis < 3; ++axis) {
-          Row row;
+          FitRow row;
           row.terms.emplace_back(kAffineUnknowns + 3 * stencil.node + axis, 1.0);
           for (const auto& [j, w] : stencil.neighbours) {
             row.terms.emplace_back(kAffineUnknowns + 3 * j + axis, -w);

@@ -38,6 +38,7 @@
 #include "core/image/projection.h"
 #include "core/mesh/mesh.h"
 #include "core/outlines/edge_image.h"
+#include "core/outlines/thickness_term.h"
 
 namespace mmm::outlines {
 
@@ -82,6 +83,9 @@ struct OutlineFitOptions {
   double nearness = 0.5;
   // Converged when no vertex moved more than this in the last iteration (mm).
   double converged_mm = 0.02;
+  // The bone's brightness inside its outline (thickness_term.h); off unless
+  // its weight is set.
+  ThicknessOptions thickness;
   std::vector<OutlineFitStage> stages = {
       {3.0, 20.0, 6, 1.0}, {1.0, 4.0, 6, 0.2}, {1.0, 2.0, 6, 0.1}};
 };
@@ -106,6 +110,9 @@ struct CorrectionPoint {
 struct FitView {
   const image::RadiographView* view = nullptr;
   std::vector<const EdgeImage*> edges;
+  // Bones over each pixel at the start of the fit, for the thickness term
+  // (bone_cover.h); null: no other bone is known.
+  const std::vector<std::uint8_t>* cover = nullptr;
 };
 
 struct BoneOutlineInput {
@@ -125,6 +132,9 @@ struct ViewFit {
   double p95_mm = 0.0;
   int corrections = 0;              // operator's points used
   double correction_mean_mm = 0.0;  // their mean distance to the fitted outline
+  int thickness_samples = 0;        // of the last iteration with the thickness term
+  double thickness_mean_mm = 0.0;   // their mean |r| (mm of bone along the ray)
+  double thickness_gain = 0.0;      // image units per mm of bone
 };
 
 struct BoneOutlineFit {
