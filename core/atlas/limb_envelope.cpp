@@ -99,7 +99,8 @@ mesh::IndexedMesh limb_envelope(const std::vector<const mesh::IndexedMesh*>& sur
   std::vector<Eigen::Vector3d> centres;
   // Ring r's vertices are r * n + k; the caps' centres go after all rings.
   std::vector<std::vector<Eigen::Vector3d>> rings;
-  std::vector<std::pair<int, int>> runs;  // [first, last] ring of each run
+  std::vector<std::vector<Vector2d>> hulls;  // per ring
+  std::vector<std::pair<int, int>> runs;     // [first, last] ring of each run
   int previous_ring = -1;
   for (int s = 0; s < slices; ++s) {
     const std::vector<Vector2d> hull = convex_hull(slab[static_cast<std::size_t>(s)]);
@@ -119,6 +120,7 @@ mesh::IndexedMesh limb_envelope(const std::vector<const mesh::IndexedMesh*>& sur
       ring.emplace_back(p.x(), p.y(), z);
     }
     rings.push_back(std::move(ring));
+    hulls.push_back(hull);
     centres.emplace_back(c.x(), c.y(), z);
     const int r = static_cast<int>(rings.size()) - 1;
     if (previous_ring < 0) {
@@ -127,6 +129,47 @@ mesh::IndexedMesh limb_envelope(const std::vector<const mesh::IndexedMesh*>& sur
       runs.back().second = r;
     }
     previous_ring = r;
+  }
+  // Smoothed along z within each run (weights 1 2 3 2 1 over five rings), so
+  // that the body has no steps where a slice's hull changes abruptly; never
+  // closer than half the fat to the slice's own hull.
+  for (const auto& [first, last] : runs) {
+    std::vector<std::vector<Eigen::Vector3d>> smoothed;
+    std::vector<Eigen::Vector3d> smoothed_centres;
+    for (int r = first; r <= last; ++r) {
+      std::vector<Eigen::Vector3d> ring(static_cast<std::size_t>(n), Eigen::Vector3d::Zero());
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      double total = 0.0;
+      for (int o = -2; o <= 2; ++o) {
+        const int q = std::clamp(r + o, first, last);
+        const double w = 3.0 - std::abs(o);
+        for (int k = 0; k < n; ++k) {
+          ring[static_cast<std::size_t>(k)] +=
+              w * rings[static_cast<std::size_t>(q)][static_cast<std::size_t>(k)];
+        }
+        centre += w * centres[static_cast<std::size_t>(q)];
+        total += w;
+      }
+      centre /= total;
+      const double z = rings[static_cast<std::size_t>(r)][0].z();
+      const Vector2d c(centre.x(), centre.y());
+      const std::vector<Vector2d>& hull = hulls[static_cast<std::size_t>(r)];
+      for (int k = 0; k < n; ++k) {
+        Eigen::Vector3d& p = ring[static_cast<std::size_t>(k)];
+        p /= total;
+        const double angle = 2.0 * std::numbers::pi * k / n;
+        const Vector2d d(std::cos(angle), std::sin(angle));
+        const double least = reach(hull, c, d) + 0.5 * options.fat_mm;
+        const double radius = std::max((Vector2d(p.x(), p.y()) - c).dot(d), least);
+        p = Eigen::Vector3d(c.x() + radius * d.x(), c.y() + radius * d.y(), z);
+      }
+      smoothed.push_back(std::move(ring));
+      smoothed_centres.emplace_back(c.x(), c.y(), z);
+    }
+    for (int r = first; r <= last; ++r) {
+      rings[static_cast<std::size_t>(r)] = std::move(smoothed[static_cast<std::size_t>(r - first)]);
+      centres[static_cast<std::size_t>(r)] = smoothed_centres[static_cast<std::size_t>(r - first)];
+    }
   }
   for (const auto& ring : rings) vertices.insert(vertices.end(), ring.begin(), ring.end());
   for (const auto& [first, last] : runs) {

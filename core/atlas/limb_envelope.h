@@ -7,8 +7,10 @@
 // surfaces within the slab (the slab widened by half a slice each side), their
 // 2D convex hull in (x, y), resampled as a star polygon of `sectors` radii
 // around its centroid and pushed outward by `fat_mm` (skin and subcutaneous
-// fat); consecutive rings joined into a tube, each run of non-empty slices
-// one closed component (fan caps at its ends), faces outward.
+// fat); the rings smoothed along z (weights 1 2 3 2 1, never closer than
+// half the fat to their slice's hull), consecutive rings joined into a tube,
+// each run of non-empty slices one closed component (fan caps at its ends),
+// faces outward.
 
 #include <vector>
 
