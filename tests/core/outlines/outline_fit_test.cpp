@@ -18,6 +18,7 @@
 #include "core/outlines/contour_points.h"
 #include "core/outlines/edge_image.h"
 #include "core/outlines/outline_fit.h"
+#include "tests/support/noiseless_pair.h"
 
 namespace mmm::outlines {
 namespace {
@@ -40,20 +41,12 @@ struct Pair {
 };
 
 Pair render(const mesh::IndexedMesh& truth, const Vector3d& isocentre = Vector3d::Zero()) {
-  image::BiplanarOptions geometry;
-  geometry.isocentre_mm = isocentre;
-  geometry.field_width_mm = 120;
-  geometry.field_height_mm = 120;
-  geometry.detector_pixel_pitch_mm = 0.5;
+  test::NoiselessPair rendered = test::render_noiseless_pair(truth, isocentre, 120);
   Pair pair;
-  pair.views = image::make_biplanar_views(geometry);
-  const mesh::AabbTree tree(truth);
-  const std::vector<image::AttenuatingMesh> meshes = {{&tree, image::kBoneMuPerMm}};
-  image::RadiographOptions detector;
-  detector.quantum_noise = false;
-  for (const image::RadiographView& view : pair.views) {
-    pair.images.push_back(image::to_radiograph(image::render_drr(view, meshes), detector));
-    pair.edges.push_back(std::make_unique<EdgeImage>(pair.images.back(), 1.0));
+  pair.views = rendered.views;
+  pair.images = std::move(rendered.images);
+  for (const image::GrayImage16& image : pair.images) {
+    pair.edges.push_back(std::make_unique<EdgeImage>(image, 1.0));
   }
   return pair;
 }

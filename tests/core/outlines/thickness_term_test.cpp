@@ -11,10 +11,10 @@
 #include <memory>
 
 #include "core/image/drr.h"
-#include "core/mesh/aabb_tree.h"
 #include "core/mesh/primitives.h"
 #include "core/outlines/outline_fit.h"
 #include "core/outlines/thickness_term.h"
+#include "tests/support/noiseless_pair.h"
 
 namespace mmm::outlines {
 namespace {
@@ -44,20 +44,11 @@ struct ThicknessPair {
 };
 
 ThicknessPair render_thickness_pair(const mesh::IndexedMesh& truth) {
-  image::BiplanarOptions geometry;
-  geometry.isocentre_mm = kSphereCentre;
-  geometry.field_width_mm = 80;
-  geometry.field_height_mm = 80;
-  geometry.detector_pixel_pitch_mm = 0.5;
+  const test::NoiselessPair rendered = test::render_noiseless_pair(truth, kSphereCentre, 80);
   ThicknessPair pair;
-  pair.views = image::make_biplanar_views(geometry);
-  const mesh::AabbTree tree(truth);
-  const std::vector<image::AttenuatingMesh> meshes = {{&tree, image::kBoneMuPerMm}};
-  image::RadiographOptions detector;
-  detector.quantum_noise = false;
-  for (const image::RadiographView& view : pair.views) {
-    pair.images.push_back(std::make_unique<EdgeImage>(
-        image::to_radiograph(image::render_drr(view, meshes), detector), 1.0));
+  pair.views = rendered.views;
+  for (const image::GrayImage16& image : rendered.images) {
+    pair.images.push_back(std::make_unique<EdgeImage>(image, 1.0));
   }
   return pair;
 }
