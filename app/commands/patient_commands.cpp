@@ -81,6 +81,7 @@ struct BonesArgs {
   std::optional<double> height_mm;
   double pixel_pitch_mm = 0.5;
   bool local_shape = false;
+  bool filled_limb = false;
 };
 
 void print_bone_patient(const atlas::BoneSetPatientReport& report, const std::string& out) {
@@ -99,6 +100,7 @@ atlas::PatientRadiographOptions radiograph_options(const BonesArgs& args) {
   atlas::PatientRadiographOptions options;
   options.detector_pixel_pitch_mm = args.pixel_pitch_mm;
   options.seed = args.seed;
+  options.soft_tissue_envelope = args.filled_limb;
   return options;
 }
 
@@ -192,6 +194,9 @@ void register_patient_commands(CLI::App& app) {
       ->add_option("--pixel-pitch", bones->pixel_pitch_mm,
                    "Detector pixel pitch (mm); 0.5 gives 0.38 mm at the isocentre")
       ->check(CLI::Range(0.05, 2.0));
+  from_bones->add_flag("--filled-limb", bones->filled_limb,
+                       "Fill the limb with soft tissue (an envelope around bones and muscles, bone "
+                       "replacing tissue) rather than render muscles standing in air");
   from_bones->callback([bones] { run_from_bones(*bones); });
 
   auto foreign = std::make_shared<BonesArgs>();
@@ -210,6 +215,9 @@ void register_patient_commands(CLI::App& app) {
                             "Add local shape to the long bones (torsion, bowing, bumps)");
   foreign_command->add_option("--pixel-pitch", foreign->pixel_pitch_mm, "Detector pixel pitch (mm)")
       ->check(CLI::Range(0.05, 2.0));
+  foreign_command->add_flag("--filled-limb", foreign->filled_limb,
+                            "Fill the limb with soft tissue (an envelope around bones and muscles, "
+                            "bone replacing tissue) rather than render muscles standing in air");
   foreign_command->callback([foreign] { run_foreign(*foreign); });
 
   auto clicks = std::make_shared<ClickArgs>();
