@@ -101,11 +101,11 @@ mesh::IndexedMesh limb_envelope(const std::vector<const mesh::IndexedMesh*>& sur
   std::vector<std::vector<Eigen::Vector3d>> rings;
   std::vector<std::vector<Vector2d>> hulls;  // per ring
   std::vector<std::pair<int, int>> runs;     // [first, last] ring of each run
-  int previous_ring = -1;
+  bool run_open = false;                     // the previous slice made a ring
   for (int s = 0; s < slices; ++s) {
     const std::vector<Vector2d> hull = convex_hull(slab[static_cast<std::size_t>(s)]);
     if (hull.size() < 3) {
-      previous_ring = -1;
+      run_open = false;
       continue;
     }
     Vector2d c = Vector2d::Zero();
@@ -123,12 +123,12 @@ mesh::IndexedMesh limb_envelope(const std::vector<const mesh::IndexedMesh*>& sur
     hulls.push_back(hull);
     centres.emplace_back(c.x(), c.y(), z);
     const int r = static_cast<int>(rings.size()) - 1;
-    if (previous_ring < 0) {
-      runs.emplace_back(r, r);
-    } else {
+    if (run_open) {
       runs.back().second = r;
+    } else {
+      runs.emplace_back(r, r);
     }
-    previous_ring = r;
+    run_open = true;
   }
   // Smoothed along z within each run (weights 1 2 3 2 1 over five rings), so
   // that the body has no steps where a slice's hull changes abruptly; never

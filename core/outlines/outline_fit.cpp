@@ -9,6 +9,7 @@
 #include <iterator>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <tuple>
 
 #include "core/errors.h"
@@ -259,6 +260,11 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
       std::vector<FitRow> rows;
       support.setZero();
       const mesh::IndexedMesh surface{current, work.F};
+      // The current surface's tree, for the thickness term of both views.
+      const bool thickness_stage =
+          thickness_on && static_cast<int>(stage) >= options.thickness.first_stage;
+      const std::optional<mesh::AabbTree> surface_tree =
+          thickness_stage ? std::optional<mesh::AabbTree>(std::in_place, surface) : std::nullopt;
       for (std::size_t v = 0; v < views.size(); ++v) {
         const image::RadiographView& view = *views[v].view;
         const EdgeImage& edges = *views[v].edges[stage];
@@ -328,11 +334,12 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
             rows.push_back(std::move(row));
           }
         }
-        if (thickness_on && static_cast<int>(stage) >= options.thickness.first_stage) {
+        if (thickness_stage) {
           ThicknessView thickness_view{&view, &edges, views[v].cover, &own_cover[v]};
           if (options.thickness.refresh_gain) gains[v] = 0.0;
-          ThicknessRows thickness = thickness_rows(surface, work.V, work_weights, model.centre,
-                                                   thickness_view, options.thickness, gains[v]);
+          ThicknessRows thickness =
+              thickness_rows(*surface_tree, work.V, work_weights, model.centre, thickness_view,
+                             options.thickness, gains[v]);
           stats.thickness_samples = static_cast<int>(thickness.rows.size());
           stats.thickness_mean_mm = thickness.residual_mm.empty()
                                         ? 0.0

@@ -4,8 +4,6 @@
 #include <cmath>
 #include <optional>
 
-#include "core/mesh/aabb_tree.h"
-
 namespace mmm::outlines {
 namespace {
 
@@ -60,11 +58,12 @@ Sample cast(const mesh::AabbTree& tree, const image::RadiographView& view, doubl
 
 }  // namespace
 
-ThicknessRows thickness_rows(const mesh::IndexedMesh& current, const Eigen::MatrixX3d& rest,
+ThicknessRows thickness_rows(const mesh::AabbTree& tree, const Eigen::MatrixX3d& rest,
                              const NodeWeights& weights, const Vector3d& centre,
                              const ThicknessView& view, const ThicknessOptions& options,
                              double& gain) {
   ThicknessRows out;
+  const mesh::IndexedMesh& current = tree.mesh();
   const image::RadiographView& geometry = *view.view;
   const double spacing = geometry.pixel_spacing_mm;
   const double step = options.step_mm / spacing;
@@ -80,7 +79,6 @@ ThicknessRows thickness_rows(const mesh::IndexedMesh& current, const Eigen::Matr
     hi_u = std::max(hi_u, p.x());
     hi_v = std::max(hi_v, p.y());
   }
-  const mesh::AabbTree tree(current);
   const auto other_bone_at = [&](int x, int y) {
     if (view.cover == nullptr) return false;
     const int count =

@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "core/image/drr.h"
+#include "core/mesh/aabb_tree.h"
 #include "core/mesh/primitives.h"
 #include "core/outlines/outline_fit.h"
 #include "core/outlines/thickness_term.h"
@@ -76,8 +77,8 @@ TEST(ThicknessTermTest, AtTheTrueSurfaceTheImageGivesBackRayLengthsAndGain) {
   for (std::size_t v = 0; v < 2; ++v) {
     double gain = 0.0;
     const ThicknessView view{&pair.views[v], pair.images[v].get(), nullptr, nullptr};
-    const ThicknessRows rows =
-        thickness_rows(truth, truth.V, no_nodes, kSphereCentre, view, options, gain);
+    const ThicknessRows rows = thickness_rows(mesh::AabbTree(truth), truth.V, no_nodes,
+                                              kSphereCentre, view, options, gain);
     ASSERT_GT(rows.rows.size(), 100U) << pair.views[v].name;
     // Image units per mm of bone: mu times the detector's counts per unit of
     // attenuation (6000 by default).
