@@ -63,11 +63,11 @@ struct ThicknessRows {
   std::vector<double> residual_mm;  // |r| per row
 };
 
-// Rows of one view for the current surface, given as its tree (`current`:
+// Rows of one view for the current surface, given as its tree (`tree`:
 // same faces as the rest surface whose vertices are `rest`, with node weights
 // `weights`; one tree serves both views). `gain` <= 0
 // is estimated from the samples and written back; a positive one is used.
-ThicknessRows thickness_rows(const mesh::AabbTree& current, const Eigen::MatrixX3d& rest,
+ThicknessRows thickness_rows(const mesh::AabbTree& tree, const Eigen::MatrixX3d& rest,
                              const NodeWeights& weights, const Eigen::Vector3d& centre,
                              const ThicknessView& view, const ThicknessOptions& options,
                              double& gain);
