@@ -4,17 +4,20 @@
 // `mmm patient foreign`) and the atlas with local shape (torsion, bowing,
 // bumps: `mmm patient synth --local-shape`) — and the time of the fit.
 //
-// Patients are made once under $MMM_BENCH_OUT_DIR/outline_patients (reused
-// when present). Landmarks: the station's (femoral head, patella, ankle
-// centres) at their true positions, so that what remains is the shape.
-// Table on stdout and in outlines.accuracy.{txt,json} (bench/table.py folds
-// it into build/bench/outlines.json).
+// Patients are made once under $MMM_BENCH_OUT_DIR/outline_patients_filled
+// (reused when present), rendered as a real limb: soft tissue filling an
+// envelope, the bones replacing it. Landmarks: the station's (femoral head,
+// patella, ankle centres) at their true positions, so that what remains is
+// the shape. Table on stdout and in outlines.accuracy.{txt,json}
+// (bench/table.py folds it into build/bench/outlines.json).
 //
 // For studying the fit: MMM_BENCH_OUTLINE_PATIENTS ("foreign_201,local_301")
 // picks patients, MMM_BENCH_OUTLINE_OPTIONS changes settings (see
 // fit_options), MMM_BENCH_OUTLINE_BONES_ONLY renders patients without soft
-// tissue (in outline_patients_bones_only/), MMM_BENCH_OUTLINE_VERBOSE prints
-// each bone's fit, writes the overlays and fitted surfaces and counts the
+// tissue (in outline_patients_bones_only/), MMM_BENCH_OUTLINE_MUSCLES_IN_AIR
+// with the muscles as soft tissue in air (outline_patients_muscles_in_air/),
+// MMM_BENCH_OUTLINE_VERBOSE prints each bone's fit, writes the overlays and
+// fitted surfaces and counts the
 // true surface's far vertices by height.
 
 #include <benchmark/benchmark.h>
@@ -94,27 +97,29 @@ Patient make_patient(const std::string& kind, std::uint64_t seed) {
   patient.kind = kind;
   const bool foreign = kind == "foreign bones";
   patient.name = (foreign ? "foreign_" : "local_") + std::to_string(seed);
-  patient.dir =
-      out_dir() /
-      (std::getenv("MMM_BENCH_OUTLINE_BONES_ONLY") != nullptr ? "outline_patients_bones_only"
-       : std::getenv("MMM_BENCH_OUTLINE_ENVELOPE") != nullptr ? "outline_patients_envelope"
-                                                              : "outline_patients") /
-      patient.name;
+  const bool bones_only = std::getenv("MMM_BENCH_OUTLINE_BONES_ONLY") != nullptr;
+  const bool in_air = std::getenv("MMM_BENCH_OUTLINE_MUSCLES_IN_AIR") != nullptr;
+  patient.dir = out_dir() /
+                (bones_only ? "outline_patients_bones_only"
+                 : in_air   ? "outline_patients_muscles_in_air"
+                            : "outline_patients_filled") /
+                patient.name;
   if (!fs::exists(patient.dir / "ground_truth.json")) {
     if (foreign) {
       mmm::atlas::ForeignBoneOptions options;
       options.deformation.seed = seed;
       options.deformation.local_shape = seed % 2 == 0;  // every other one with local shape too
       mmm::atlas::BoneSet set = mmm::atlas::gait2392_bone_set(atlas_dir(), MMM_DATA_DIR, options);
-      if (std::getenv("MMM_BENCH_OUTLINE_BONES_ONLY") != nullptr) set.soft_tissue.clear();
+      if (bones_only) set.soft_tissue.clear();
       mmm::atlas::PatientRadiographOptions pictures;
       pictures.seed = seed;
-      pictures.soft_tissue_envelope = std::getenv("MMM_BENCH_OUTLINE_ENVELOPE") != nullptr;
+      pictures.soft_tissue_envelope = !bones_only && !in_air;
       mmm::atlas::make_bone_set_patient(set, atlas_dir(), patient.dir, pictures);
     } else {
       mmm::atlas::SyntheticPatientOptions options;
       options.deformation.seed = seed;
       options.deformation.local_shape = true;
+      options.soft_tissue_envelope = !in_air;
       mmm::atlas::make_synthetic_patient(atlas_dir(), patient.dir, options);
     }
   }
@@ -280,7 +285,9 @@ Row measure(const Patient& patient) {
                   << b.moved_mean_mm << " / " << b.moved_max_mm << " mm, held " << b.held_by_prior;
         for (const auto& v : b.views) {
           std::cerr << " | " << v.view << " " << v.matched << "/" << v.contour_points << " "
-                    << v.start_mean_mm << " -> " << v.mean_mm << " (p95 " << v.p95_mm << ")";
+                    << v.start_mean_mm << " -> " << v.mean_mm << " (p95 " << v.p95_mm << ")"
+                    << " thickness " << v.thickness_samples << " rays, mean "
+                    << v.thickness_mean_mm << " mm, gain " << v.thickness_gain;
         }
         std::cerr << "\n";
       }

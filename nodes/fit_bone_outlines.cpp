@@ -182,8 +182,9 @@ workflow::NodeSpec FitBoneOutlines::spec() {
                      {.min = 0.05, .max = 20}, "mm")
       .param<double>("thickness_weight", d.fit.thickness.weight,
                      "Weight per sample ray of the bone's brightness inside its outline against "
-                     "the ray's length through the surface (0: outlines only). Needs radiographs "
-                     "whose soft tissue is smooth across the bone, as in a real limb",
+                     "the ray's length through the surface (0: outlines only; the rays together "
+                     "weigh at most twice the outline). Needs radiographs whose soft tissue is "
+                     "smooth across the bone, as in a real limb",
                      {.min = 0, .max = 100})
       .param<std::int64_t>("threads", d.threads, "Worker threads", {.min = 1, .max = 64})
       .output<Atlas>("atlas", "The patient's atlas with the bones fitted to the radiographs")

@@ -29,8 +29,13 @@ struct SynthArgs {
   std::optional<double> height_mm;
   double pixel_pitch_mm = 0.5;
   bool local_shape = false;
+  bool muscles_in_air = false;
   bool json = false;
 };
+
+constexpr const char* kMusclesInAirHelp =
+    "Render the muscles as soft tissue standing in air, bone on top, rather than the limb filled "
+    "with soft tissue that the bones replace (the default, as in a real radiograph)";
 
 void run_synth(const SynthArgs& args) {
   atlas::SyntheticPatientOptions options;
@@ -38,6 +43,7 @@ void run_synth(const SynthArgs& args) {
   options.deformation.height_mm = args.height_mm;
   options.detector_pixel_pitch_mm = args.pixel_pitch_mm;
   options.deformation.local_shape = args.local_shape;
+  options.soft_tissue_envelope = !args.muscles_in_air;
   const atlas::SyntheticPatientReport report =
       atlas::make_synthetic_patient(args.atlas, args.out, options);
   if (args.json) {
@@ -81,7 +87,7 @@ struct BonesArgs {
   std::optional<double> height_mm;
   double pixel_pitch_mm = 0.5;
   bool local_shape = false;
-  bool filled_limb = false;
+  bool muscles_in_air = false;
 };
 
 void print_bone_patient(const atlas::BoneSetPatientReport& report, const std::string& out) {
@@ -94,13 +100,18 @@ void print_bone_patient(const atlas::BoneSetPatientReport& report, const std::st
             << report.seconds << " s\n"
             << "  " << out << "/bones (ground truth), ground_truth.json, radiographs/"
             << "{frontal,lateral}.png + views.json\n";
+  for (const std::string& bone : report.solidified) {
+    std::cout << "  " << bone
+              << ": not a single closed surface; the truth and the radiographs use the boundary "
+                 "of the solid it encloses (1 mm grid)\n";
+  }
 }
 
 atlas::PatientRadiographOptions radiograph_options(const BonesArgs& args) {
   atlas::PatientRadiographOptions options;
   options.detector_pixel_pitch_mm = args.pixel_pitch_mm;
   options.seed = args.seed;
-  options.soft_tissue_envelope = args.filled_limb;
+  options.soft_tissue_envelope = !args.muscles_in_air;
   return options;
 }
 
@@ -177,6 +188,7 @@ void register_patient_commands(CLI::App& app) {
   synth->add_flag("--local-shape", args->local_shape,
                   "Add local shape to the long bones (torsion, bowing, bumps): what no smooth "
                   "map of the atlas produces");
+  synth->add_flag("--muscles-in-air", args->muscles_in_air, kMusclesInAirHelp);
   synth->add_flag("--json", args->json, "Print the drawn factors as JSON");
   synth->callback([args] { run_synth(*args); });
 
@@ -194,9 +206,7 @@ void register_patient_commands(CLI::App& app) {
       ->add_option("--pixel-pitch", bones->pixel_pitch_mm,
                    "Detector pixel pitch (mm); 0.5 gives 0.38 mm at the isocentre")
       ->check(CLI::Range(0.05, 2.0));
-  from_bones->add_flag("--filled-limb", bones->filled_limb,
-                       "Fill the limb with soft tissue (an envelope around bones and muscles, bone "
-                       "replacing tissue) rather than render muscles standing in air");
+  from_bones->add_flag("--muscles-in-air", bones->muscles_in_air, kMusclesInAirHelp);
   from_bones->callback([bones] { run_from_bones(*bones); });
 
   auto foreign = std::make_shared<BonesArgs>();
@@ -215,9 +225,7 @@ void register_patient_commands(CLI::App& app) {
                             "Add local shape to the long bones (torsion, bowing, bumps)");
   foreign_command->add_option("--pixel-pitch", foreign->pixel_pitch_mm, "Detector pixel pitch (mm)")
       ->check(CLI::Range(0.05, 2.0));
-  foreign_command->add_flag("--filled-limb", foreign->filled_limb,
-                            "Fill the limb with soft tissue (an envelope around bones and muscles, "
-                            "bone replacing tissue) rather than render muscles standing in air");
+  foreign_command->add_flag("--muscles-in-air", foreign->muscles_in_air, kMusclesInAirHelp);
   foreign_command->callback([foreign] { run_foreign(*foreign); });
 
   auto clicks = std::make_shared<ClickArgs>();

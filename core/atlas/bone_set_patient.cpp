@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "core/atlas/atlas_io.h"
@@ -11,8 +12,11 @@
 #include "core/file_bytes.h"
 #include "core/fit/sphere_fit.h"
 #include "core/mesh/aabb_tree.h"
+#include "core/mesh/decimate.h"
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/mass_properties.h"
+#include "core/mesh/mesh_check.h"
+#include "core/mesh/solidify.h"
 
 namespace mmm::atlas {
 namespace {
@@ -66,6 +70,30 @@ Eigen::Vector3d sphere_centre_near(const mesh::IndexedMesh& given, const mesh::A
 
 nlohmann::json point_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
+// The bones as closed surfaces. A broken one (holes, non-manifold edges,
+// several pieces: OpenSim's gait2392 pelvis) would render radiographs of
+// something other than the surface the fit is measured against (a ray through
+// a hole loses the bone); it is replaced by the boundary of the solid it
+// encloses, named in `solidified`.
+std::map<std::string, mesh::IndexedMesh> closed_bones(const BoneSet& set,
+                                                      std::vector<std::string>& solidified) {
+  std::map<std::string, mesh::IndexedMesh> bones;
+  for (const auto& [name, surface] : set.bones) {
+    const mesh::MeshCheckReport health = mesh::check_mesh(surface);
+    if (health.watertight() && health.connected_components == 1) {
+      bones[name] = surface;
+      continue;
+    }
+    // The grid's level set has about 2.5 faces per mm^2: simplified (quadric
+    // collapses move it by far less than the grid's spacing).
+    mesh::DecimateOptions fewer;
+    fewer.target_faces = kSolidifiedFaces;
+    bones[name] = mesh::decimate(mesh::solidify(surface, {kSolidifyGridMm, 2}), fewer);
+    solidified.push_back(name);
+  }
+  return bones;
+}
+
 }  // namespace
 
 BoneSetPatientReport make_bone_set_patient(const BoneSet& set,
@@ -97,10 +125,13 @@ BoneSetPatientReport make_bone_set_patient(const BoneSet& set,
     }
   }
 
+  BoneSetPatientReport report;
+  const std::map<std::string, mesh::IndexedMesh> bones = closed_bones(set, report.solidified);
+
   const std::filesystem::path partial = out_dir.string() + ".partial";
   std::filesystem::remove_all(partial);
   std::filesystem::create_directories(partial / "bones");
-  for (const auto& [name, surface] : set.bones) {
+  for (const auto& [name, surface] : bones) {
     mesh::write_mesh(surface, partial / "bones" / (name + ".ply"));
   }
   std::map<std::string, mesh::IndexedMesh> soft;
@@ -108,16 +139,15 @@ BoneSetPatientReport make_bone_set_patient(const BoneSet& set,
     soft["soft_tissue_" + std::to_string(i)] = set.soft_tissue[i];
   }
   const std::array<image::RadiographView, 2> views =
-      write_patient_radiographs(set.bones, soft, partial / "radiographs", options);
+      write_patient_radiographs(bones, soft, partial / "radiographs", options);
 
-  BoneSetPatientReport report;
   nlohmann::json landmarks = nlohmann::json::object();
   std::map<std::string, std::unique_ptr<mesh::AabbTree>> trees;
   std::map<std::string, Eigen::Affine3d> registrations;
   for (const Landmark& landmark : atlas.landmarks) {
-    const auto bone = set.bones.find(landmark.bone);
+    const auto bone = bones.find(landmark.bone);
     const auto given = set.landmarks.find(landmark.name);
-    if (bone == set.bones.end() && given == set.landmarks.end()) continue;
+    if (bone == bones.end() && given == set.landmarks.end()) continue;
     Eigen::Vector3d position;
     std::string from;
     if (given != set.landmarks.end()) {
@@ -164,6 +194,7 @@ BoneSetPatientReport make_bone_set_patient(const BoneSet& set,
   truth["source"] = set.source;
   truth["bones"] = nlohmann::json::array();
   for (const auto& [name, surface] : set.bones) truth["bones"].push_back(name);
+  truth["solidified"] = report.solidified;
   truth["landmarks"] = landmarks;
   {
     std::ofstream out(partial / "ground_truth.json");

@@ -5,9 +5,15 @@
 //
 // Folder written (`mmm patient from-bones MANIFEST --atlas ATLAS -o PDIR`),
 // the layout of `mmm patient synth` where it applies:
-//   bones/<bone>.ply          the true surfaces (patient frame, mm)
+//   bones/<bone>.ply          the true surfaces (patient frame, mm); a bone
+//                             given as a broken surface (holes, non-manifold
+//                             edges, several pieces) as the boundary of the
+//                             solid it encloses (mesh/solidify.h, 1 mm grid,
+//                             simplified to 40,000 faces),
+//                             which is what the radiographs show
 //   ground_truth.json         {"format": "mmm-bone-set-patient", "version": 1,
 //                              "atlas", "source", "bones": [...],
+//                              "solidified": [bones rebuilt so],
 //                              "landmarks": {name: {"bone", "position_mm",
 //                              "pixels": {view: [u, v]}, "from": "given" |
 //                              "<how it was derived>"}}}
@@ -27,14 +33,19 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "core/atlas/bone_set.h"
 #include "core/atlas/patient_radiographs.h"
 
 namespace mmm::atlas {
 
+inline constexpr double kSolidifyGridMm = 1.0;
+inline constexpr Eigen::Index kSolidifiedFaces = 40000;  // a rebuilt bone simplified to
+
 struct BoneSetPatientReport {
   int bones = 0;
+  std::vector<std::string> solidified;  // bones given as broken surfaces, rebuilt closed
   int landmarks_given = 0;
   int landmarks_derived = 0;
   int frontal_width = 0;

@@ -36,8 +36,9 @@ struct PatientRadiographOptions {
   // (limb_envelope.h) filled with tissue at mu_soft, the bones replacing it
   // (mu_bone - mu_soft), the muscles only muscle_contrast_per_mm above it
   // (muscle against fat: 0.021 against 0.018 /mm). Off: the soft-tissue
-  // surfaces at mu_soft in air and the bones at mu_bone on top.
-  bool soft_tissue_envelope = false;
+  // surfaces at mu_soft in air and the bones at mu_bone on top (sharp muscle
+  // edges as bright as millimetres of bone: no real radiograph looks so).
+  bool soft_tissue_envelope = true;
   double muscle_contrast_per_mm = 0.003;
   double envelope_fat_mm = 8.0;
   image::RadiographOptions radiograph;  // detector noise; its seed is combined with `seed`

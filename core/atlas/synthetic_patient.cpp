@@ -131,6 +131,7 @@ SyntheticPatientReport make_synthetic_patient(const std::filesystem::path& atlas
   pictures.field_margin_mm = options.field_margin_mm;
   pictures.mu_bone_per_mm = options.mu_bone_per_mm;
   pictures.mu_soft_per_mm = options.mu_soft_per_mm;
+  pictures.soft_tissue_envelope = options.soft_tissue_envelope;
   pictures.radiograph = options.radiograph;
   pictures.seed = options.deformation.seed;
   pictures.threads = options.threads;

@@ -36,6 +36,7 @@ struct SyntheticPatientOptions {
   double mu_bone_per_mm = image::kBoneMuPerMm;
   double mu_soft_per_mm = image::kSoftTissueMuPerMm;
   std::string muscle_level = "lod1";    // muscles enter the DRR at this resolution
+  bool soft_tissue_envelope = true;     // the limb filled (patient_radiographs.h)
   image::RadiographOptions radiograph;  // seed: the patient's seed unless set otherwise
   int threads = 2;
 };

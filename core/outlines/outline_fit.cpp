@@ -347,6 +347,13 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
                                                           thickness.residual_mm.end(), 0.0) /
                                               static_cast<double>(thickness.residual_mm.size());
           stats.thickness_gain = gains[v];
+          // On a coarse surface (few contour points against many rays) the
+          // term's total weight is capped at max_share times the outline's.
+          const double total =
+              options.thickness.weight * static_cast<double>(thickness.rows.size());
+          const double cap = options.thickness.max_share * static_cast<double>(contour.size());
+          const double scale = total > cap ? cap / total : 1.0;
+          for (FitRow& row : thickness.rows) row.weight *= scale;
           std::ranges::move(thickness.rows, std::back_inserter(rows));
         }
         stats.matched = static_cast<int>(residuals.size());

@@ -40,7 +40,11 @@
 namespace mmm::outlines {
 
 struct ThicknessOptions {
-  double weight = 0.0;   // per sample, against 1 per contour point; 0: the term is off
+  double weight = 0.0;  // per sample, against 1 per contour point; 0: the term is off
+  // The term's total weight in a view is at most max_share times its contour
+  // points' (on real bone shapes weight 0.3 gives 0.5-1.8; on a coarse
+  // surface with few contour points the rays would outweigh the outlines).
+  double max_share = 2.0;
   int first_stage = 1;   // the stages from which it acts (after the outlines have settled)
   double step_mm = 2.0;  // sample grid pitch at the isocentre
   double margin_mm = 3.0;
