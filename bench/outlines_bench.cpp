@@ -119,7 +119,8 @@ Patient make_patient(const std::string& kind, std::uint64_t seed) {
       mmm::atlas::SyntheticPatientOptions options;
       options.deformation.seed = seed;
       options.deformation.local_shape = true;
-      options.soft_tissue_envelope = !in_air;
+      options.soft_tissue_envelope = !in_air && !bones_only;
+      if (bones_only) options.mu_soft_per_mm = 0.0;  // the muscles drawn at 0: bones alone
       mmm::atlas::make_synthetic_patient(atlas_dir(), patient.dir, options);
     }
   }
@@ -286,8 +287,8 @@ Row measure(const Patient& patient) {
         for (const auto& v : b.views) {
           std::cerr << " | " << v.view << " " << v.matched << "/" << v.contour_points << " "
                     << v.start_mean_mm << " -> " << v.mean_mm << " (p95 " << v.p95_mm << ")"
-                    << " thickness " << v.thickness_samples << " rays, mean "
-                    << v.thickness_mean_mm << " mm, gain " << v.thickness_gain;
+                    << " thickness " << v.thickness_samples << " rays, mean " << v.thickness_mean_mm
+                    << " mm, gain " << v.thickness_gain;
         }
         std::cerr << "\n";
       }
