@@ -99,6 +99,7 @@ Patient make_patient(const std::string& kind, std::uint64_t seed) {
   patient.name = (foreign ? "foreign_" : "local_") + std::to_string(seed);
   const bool bones_only = std::getenv("MMM_BENCH_OUTLINE_BONES_ONLY") != nullptr;
   const bool in_air = std::getenv("MMM_BENCH_OUTLINE_MUSCLES_IN_AIR") != nullptr;
+  const bool filled = !bones_only && !in_air;
   patient.dir = out_dir() /
                 (bones_only ? "outline_patients_bones_only"
                  : in_air   ? "outline_patients_muscles_in_air"
@@ -113,13 +114,13 @@ Patient make_patient(const std::string& kind, std::uint64_t seed) {
       if (bones_only) set.soft_tissue.clear();
       mmm::atlas::PatientRadiographOptions pictures;
       pictures.seed = seed;
-      pictures.soft_tissue_envelope = !bones_only && !in_air;
+      pictures.soft_tissue_envelope = filled;
       mmm::atlas::make_bone_set_patient(set, atlas_dir(), patient.dir, pictures);
     } else {
       mmm::atlas::SyntheticPatientOptions options;
       options.deformation.seed = seed;
       options.deformation.local_shape = true;
-      options.soft_tissue_envelope = !in_air && !bones_only;
+      options.soft_tissue_envelope = filled;
       if (bones_only) options.mu_soft_per_mm = 0.0;  // the muscles drawn at 0: bones alone
       mmm::atlas::make_synthetic_patient(atlas_dir(), patient.dir, options);
     }

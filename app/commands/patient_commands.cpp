@@ -103,7 +103,8 @@ void print_bone_patient(const atlas::BoneSetPatientReport& report, const std::st
   for (const std::string& bone : report.solidified) {
     std::cout << "  " << bone
               << ": not a single closed surface; the truth and the radiographs use the boundary "
-                 "of the solid it encloses (1 mm grid)\n";
+                 "of the solid it encloses ("
+              << atlas::kSolidifyGridMm << " mm grid)\n";
   }
 }
 

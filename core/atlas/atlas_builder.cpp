@@ -425,7 +425,7 @@ void Builder::build_bones() {
           transformed(merged(opensim_meshes(recipe_bone.body, recipe_bone.opensim_meshes)),
                       maps_.map.at(recipe_bone.body));
       const mesh::MeshCheckReport health = mesh::check_mesh(surface);
-      if (!health.watertight() || health.connected_components > 1) {
+      if (!health.single_solid()) {
         // Holes, non-manifold edges or several pieces (gait2392's pelvis):
         // the boundary of the solid it encloses instead.
         surface = mesh::solidify(surface, {2.0, 2});

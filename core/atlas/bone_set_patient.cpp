@@ -79,8 +79,7 @@ std::map<std::string, mesh::IndexedMesh> closed_bones(const BoneSet& set,
                                                       std::vector<std::string>& solidified) {
   std::map<std::string, mesh::IndexedMesh> bones;
   for (const auto& [name, surface] : set.bones) {
-    const mesh::MeshCheckReport health = mesh::check_mesh(surface);
-    if (health.watertight() && health.connected_components == 1) {
+    if (mesh::check_mesh(surface).single_solid()) {
       bones[name] = surface;
       continue;
     }

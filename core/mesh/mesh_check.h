@@ -54,6 +54,8 @@ struct MeshCheckReport {
   [[nodiscard]] bool watertight() const {
     return closed() && manifold() && orientation_consistent();
   }
+  // Watertight and in one piece: one solid's surface, as a bone's should be.
+  [[nodiscard]] bool single_solid() const { return watertight() && connected_components == 1; }
   // One line per problem found, empty for a clean watertight mesh.
   [[nodiscard]] std::vector<std::string> problems() const;
 };
