@@ -199,6 +199,19 @@ outlines::AtlasOutlineFitOptions fit_options() {
     if (key == "thickcut") options.fit.thickness.cutoff = value;
     if (key == "thickrefresh") options.fit.thickness.refresh_gain = value != 0;
     if (key == "thickrobust") options.fit.thickness.robust_mm = value;
+    if (key == "softmodel") options.soft_tissue_model = value != 0;
+    if (key == "softfat") options.soft_tissue.fat_mm = value;
+    if (key == "softskin") options.soft_tissue.skin_margin_mm = value;
+    if (key == "softoutline") options.soft_tissue.fit_outline = value != 0;
+    if (key == "pelvis_free" && value != 0)
+      options.tissue_free_bones = {"pelvis", "pelvis_l", "sacrum"};
+    if (key == "all_free" && value != 0)
+      options.tissue_free_bones = {"pelvis",  "pelvis_l", "sacrum",
+                                   "femur_r", "tibia_r",  "fibula_r"};
+    if (key == "pelvis_thick") {
+      for (const char* bone : {"pelvis", "pelvis_l", "sacrum"})
+        options.thickness_factor[bone] = value;
+    }
     if (key == "sigma0") options.fit.stages[0].sigma_px = value;
     if (key.starts_with("sf"))
       options.fit.stages.at(std::stoul(key.substr(2))).smoothness_factor = value;
@@ -239,6 +252,15 @@ Row measure(const Patient& patient) {
   row.kind = patient.kind;
   row.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (std::getenv("MMM_BENCH_OUTLINE_VERBOSE") != nullptr) {
+    std::cerr << patient.name << " images and soft tissue " << fit.images_seconds << " s, fit "
+              << fit.fit_seconds << " s\n";
+    for (const outlines::SoftTissueLaw& law : fit.soft_tissue) {
+      std::cerr << patient.name << " soft tissue " << law.view << (law.used ? "" : " (not used)")
+                << ": offset " << law.offset << ", tissue " << law.tissue_per_mm << "/mm, muscle "
+                << law.muscle_per_mm << "/mm, " << law.samples << " pixels, rms "
+                << law.residual_rms << ", outline rows " << law.rows_matched << ", width ratio "
+                << law.median_width_ratio << "\n";
+    }
     std::vector<mmm::mesh::IndexedMesh> shown;
     shown.reserve(2 * fit.bones.size() + kMeasured.size());
     std::vector<mmm::image::OutlineItem> items;

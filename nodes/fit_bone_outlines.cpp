@@ -74,6 +74,7 @@ outlines::AtlasOutlineFitOptions options_from(const workflow::NodeContext& conte
   options.fit.bending_weight = context.number("bending_weight");
   options.fit.robust_mm = context.number("robust_mm");
   options.fit.thickness.weight = context.number("thickness_weight");
+  options.tissue_free_bones = split_names(context.text("tissue_free_bones"));
   options.threads = static_cast<int>(context.integer("threads"));
   return options;
 }
@@ -114,9 +115,23 @@ nlohmann::json fit_report(const outlines::AtlasOutlineFit& fit) {
     }
     bones.push_back(entry);
   }
+  // The soft tissue's law on each view, when the thickness term modelled it.
+  nlohmann::json soft = nlohmann::json::array();
+  for (const outlines::SoftTissueLaw& law : fit.soft_tissue) {
+    soft.push_back({{"view", law.view},
+                    {"used", law.used},
+                    {"offset", law.offset},
+                    {"tissue_per_mm", law.tissue_per_mm},
+                    {"muscle_per_mm", law.muscle_per_mm},
+                    {"pixels", law.samples},
+                    {"residual_rms", law.residual_rms},
+                    {"outline_rows", law.rows_matched},
+                    {"limb_width_ratio", law.median_width_ratio}});
+  }
   return {{"format", "mmm-outline-fit"},
           {"version", 1},
           {"bones", bones},
+          {"soft_tissue", soft},
           {"not_fitted", fit.not_fitted},
           {"images_seconds", fit.images_seconds},
           {"fit_seconds", fit.fit_seconds}};
@@ -183,9 +198,13 @@ workflow::NodeSpec FitBoneOutlines::spec() {
       .param<double>("thickness_weight", d.fit.thickness.weight,
                      "Weight per sample ray of the bone's brightness inside its outline against "
                      "the ray's length through the surface (0: outlines only; the rays together "
-                     "weigh at most twice the outline). Needs radiographs whose soft tissue is "
-                     "smooth across the bone, as in a real limb",
+                     "weigh at most twice the outline; off for the hip bones and sacrum). The "
+                     "soft tissue under each bone is predicted from the atlas's muscles and the "
+                     "limb's outline on the images",
                      {.min = 0, .max = 100})
+      .param<std::string>("tissue_free_bones", bone_list(d.tissue_free_bones),
+                          "Bones whose outlines are sought with the predicted soft tissue taken "
+                          "out of the radiographs (comma-separated; empty: none)")
       .param<std::int64_t>("threads", d.threads, "Worker threads", {.min = 1, .max = 64})
       .output<Atlas>("atlas", "The patient's atlas with the bones fitted to the radiographs")
       .output<Report>("report", "Per bone and view: contour residuals, movement, convergence")

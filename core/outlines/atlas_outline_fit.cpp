@@ -71,6 +71,12 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
                               "' is not a positive number; hint: e.g. 3");
     }
   }
+  for (const auto& [name, factor] : options.thickness_factor) {
+    if (!(factor >= 0) || !std::isfinite(factor)) {
+      throw InvalidInputError("outline fit: the thickness factor of bone '" + name +
+                              "' is not a number >= 0; hint: 0 turns the term off for it");
+    }
+  }
   const std::vector<image::RadiographView> views = pair.calibrated_views();
   std::vector<std::string> view_names;
   view_names.reserve(views.size());
@@ -112,7 +118,12 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
   }
   // Where the bones lie on each view at the start, for the thickness term.
   std::vector<std::vector<std::uint8_t>> covers(views.size());
-  if (options.fit.thickness.weight > 0) {
+  std::vector<SoftTissueImage> soft;
+  // The soft tissue's model serves the thickness term and the bones whose
+  // outlines are sought without it.
+  const bool model_tissue = options.soft_tissue_model && (options.fit.thickness.weight > 0 ||
+                                                          !options.tissue_free_bones.empty());
+  if (options.fit.thickness.weight > 0 || model_tissue) {
     std::vector<const mesh::IndexedMesh*> surfaces;
     for (const atlas::Bone& bone : atlas.bones) {
       const auto levels = meshes.find(bone.name);
@@ -124,6 +135,50 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
     parallel_for(views.size(), options.threads,
                  [&](std::size_t v) { covers[v] = count_cover(surfaces, views[v]); });
     for (std::size_t v = 0; v < views.size(); ++v) fit_views[v].cover = &covers[v];
+    if (model_tissue && !surfaces.empty()) {
+      std::vector<const mesh::IndexedMesh*> muscles;
+      for (const atlas::Muscle& muscle : atlas.muscles) {
+        const auto levels = meshes.find(muscle.name);
+        if (levels == meshes.end()) continue;
+        const auto level = levels->second.find(options.work_level);
+        muscles.push_back(level != levels->second.end() ? &level->second
+                                                        : &levels->second.at("full"));
+      }
+      std::vector<const EdgeImage*> smooth;
+      // The finest stage's image: the least blur against the model's sharp edges.
+      for (const FitView& view : fit_views) smooth.push_back(view.edges.back());
+      SoftTissueModelOptions model = options.soft_tissue;
+      model.threads = options.threads;
+      soft = model_soft_tissue(surfaces, muscles, views, smooth, model);
+      for (std::size_t v = 0; v < views.size(); ++v) {
+        const SoftTissueImage& law = soft[v];
+        fit_views[v].soft = &law;
+        result.soft_tissue.push_back({views[v].name, law.usable(), law.offset, law.tissue_per_mm,
+                                      law.muscle_per_mm, law.samples, law.residual_rms,
+                                      law.rows_matched, law.median_width_ratio});
+      }
+    }
+  }
+  // The same views over the radiographs without the modelled soft tissue.
+  std::vector<std::unique_ptr<EdgeImage>> tissue_free_images;
+  std::vector<FitView> tissue_free_views;
+  if (!options.tissue_free_bones.empty() && soft.size() == views.size()) {
+    tissue_free_images.resize(images.size());
+    parallel_for(images.size(), options.threads, [&](std::size_t k) {
+      const std::size_t v = k / sigmas.size();
+      tissue_free_images[k] = std::make_unique<EdgeImage>(
+          without_soft_tissue(radiographs[v], soft[v]), sigmas[k % sigmas.size()]);
+    });
+    tissue_free_views = fit_views;
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      tissue_free_views[v].soft = nullptr;
+      tissue_free_views[v].edges.clear();
+      for (const OutlineFitStage& stage : options.fit.stages) {
+        const auto s =
+            static_cast<std::size_t>(std::ranges::find(sigmas, stage.sigma_px) - sigmas.begin());
+        tissue_free_views[v].edges.push_back(tissue_free_images[v * sigmas.size() + s].get());
+      }
+    }
   }
   result.images_seconds = seconds_since(start);
 
@@ -158,7 +213,15 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
         factor != options.membrane_factor.end()) {
       fit.smoothness_weight *= factor->second;
     }
-    result.bones[order[k]] = fit_bone_outline(input, fit_views, fit);
+    if (const auto factor = options.thickness_factor.find(bone.name);
+        factor != options.thickness_factor.end()) {
+      fit.thickness.weight *= factor->second;
+    }
+    const bool tissue_free =
+        !tissue_free_views.empty() &&
+        std::ranges::find(options.tissue_free_bones, bone.name) != options.tissue_free_bones.end();
+    result.bones[order[k]] =
+        fit_bone_outline(input, tissue_free ? tissue_free_views : fit_views, fit);
   });
   result.fit_seconds = seconds_since(start);
   for (const atlas::Bone& bone : atlas.bones) {

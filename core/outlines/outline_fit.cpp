@@ -335,7 +335,7 @@ BoneOutlineFit fit_bone_outline(const BoneOutlineInput& input, const std::vector
           }
         }
         if (thickness_stage) {
-          ThicknessView thickness_view{&view, &edges, views[v].cover, &own_cover[v]};
+          ThicknessView thickness_view{&view, &edges, views[v].cover, &own_cover[v], views[v].soft};
           if (options.thickness.refresh_gain) gains[v] = 0.0;
           ThicknessRows thickness =
               thickness_rows(*surface_tree, work.V, work_weights, model.centre, thickness_view,

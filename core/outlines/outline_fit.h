@@ -38,6 +38,7 @@
 #include "core/image/projection.h"
 #include "core/mesh/mesh.h"
 #include "core/outlines/edge_image.h"
+#include "core/outlines/soft_tissue_model.h"
 #include "core/outlines/thickness_term.h"
 
 namespace mmm::outlines {
@@ -113,6 +114,9 @@ struct FitView {
   // Bones over each pixel at the start of the fit, for the thickness term
   // (bone_cover.h); null: no other bone is known.
   const std::vector<std::uint8_t>* cover = nullptr;
+  // The soft tissue's predicted image, for the thickness term
+  // (soft_tissue_model.h); null: a straight background across the bone.
+  const SoftTissueImage* soft = nullptr;
 };
 
 struct BoneOutlineInput {

@@ -102,6 +102,8 @@ ThicknessRows thickness_rows(const mesh::AabbTree& tree, const Eigen::MatrixX3d&
   const auto inside_image = [&](double u, double v) {
     return u >= 1.0 && v >= 1.0 && u <= geometry.width - 1.0 && v <= geometry.height - 1.0;
   };
+  const bool soft = view.soft != nullptr && view.soft->usable();
+  const auto soft_at = [&](double u, double v) { return soft ? view.soft->at({u, v}) : 0.0; };
   // What the image says: the excess over the row's background, per sample.
   std::vector<std::pair<double, const Sample*>> kept;
   for (std::size_t i = 0; i < grid.size(); ++i) {
@@ -120,13 +122,14 @@ ThicknessRows thickness_rows(const mesh::AabbTree& tree, const Eigen::MatrixX3d&
          x <= static_cast<int>(std::ceil(right)) + 1 && !crossed; ++x) {
       crossed = x >= 0 && x < geometry.width && other_bone_at(x, row);
     }
-    if (crossed) continue;
-    const double background_left = view.image->sample({left, v});
-    const double background_right = view.image->sample({right, v});
+    if (crossed || (soft && !view.soft->holds(v))) continue;
+    const double background_left = view.image->sample({left, v}) - soft_at(left, v);
+    const double background_right = view.image->sample({right, v}) - soft_at(right, v);
     for (const Sample& sample : line) {
       if (!sample.usable || sample.length <= 0) continue;
       const double t = (sample.u - left) / (right - left);
-      const double background = (1.0 - t) * background_left + t * background_right;
+      const double background =
+          (1.0 - t) * background_left + t * background_right + soft_at(sample.u, v);
       kept.emplace_back(view.image->sample({sample.u, v}) - background, &sample);
     }
   }

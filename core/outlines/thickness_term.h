@@ -10,7 +10,9 @@
 // step_mm at the isocentre) over the bone's current projection, per image row:
 //   background B(u): the image linearly interpolated between two points
 //     margin_mm outside the current outline on either side (the soft tissue
-//     around the bone, smooth across it)
+//     around the bone); with a soft-tissue model S (soft_tissue_model.h),
+//     S(u) plus the line through I - S at those points, so that the tissue
+//     under the bone follows the limb's shape rather than a straight line
 //   excess e = I(u, v) - B(u)            what the bone adds along the ray
 //   gain g = sum e L / sum L^2           counts per mm of bone, estimated once
 //                                        per view at the term's first use
@@ -36,6 +38,7 @@
 #include "core/outlines/bone_cover.h"
 #include "core/outlines/edge_image.h"
 #include "core/outlines/fit_rows.h"
+#include "core/outlines/soft_tissue_model.h"
 
 namespace mmm::outlines {
 
@@ -60,6 +63,9 @@ struct ThicknessView {
   const EdgeImage* image = nullptr;                  // the radiograph, smoothed
   const std::vector<std::uint8_t>* cover = nullptr;  // bones over each pixel; null: none
   const BoneCover* own = nullptr;                    // this bone's part of `cover`
+  // The soft tissue's predicted image (soft_tissue_model.h): the background
+  // follows its shape between the two sides; null or unusable: a straight line.
+  const SoftTissueImage* soft = nullptr;
 };
 
 struct ThicknessRows {
