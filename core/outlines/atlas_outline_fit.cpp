@@ -145,6 +145,7 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
                                                         : &levels->second.at("full"));
       }
       std::vector<const EdgeImage*> smooth;
+      smooth.reserve(fit_views.size());
       // The finest stage's image: the least blur against the model's sharp edges.
       for (const FitView& view : fit_views) smooth.push_back(view.edges.back());
       SoftTissueModelOptions model = options.soft_tissue;

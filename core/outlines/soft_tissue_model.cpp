@@ -207,7 +207,8 @@ std::vector<Eigen::Vector3d> limb_axis(const mesh::IndexedMesh& envelope) {
     ++count;
   }
   std::vector<Eigen::Vector3d> axis;
-  for (const auto& [slab, mean] : slabs) axis.push_back(mean.first / mean.second);
+  axis.reserve(slabs.size());
+  for (const auto& [slab, mean] : slabs) axis.emplace_back(mean.first / mean.second);
   return axis;
 }
 
