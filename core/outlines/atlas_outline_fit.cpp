@@ -124,13 +124,16 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
   const bool model_tissue = options.soft_tissue_model && (options.fit.thickness.weight > 0 ||
                                                           !options.tissue_free_bones.empty());
   if (options.fit.thickness.weight > 0 || model_tissue) {
+    // An element's work level, else its full one; null when the atlas has no mesh for it.
+    const auto work_mesh = [&](const std::string& name) -> const mesh::IndexedMesh* {
+      const auto levels = meshes.find(name);
+      if (levels == meshes.end()) return nullptr;
+      const auto level = levels->second.find(options.work_level);
+      return level != levels->second.end() ? &level->second : &levels->second.at("full");
+    };
     std::vector<const mesh::IndexedMesh*> surfaces;
     for (const atlas::Bone& bone : atlas.bones) {
-      const auto levels = meshes.find(bone.name);
-      if (levels == meshes.end()) continue;
-      const auto level = levels->second.find(options.work_level);
-      surfaces.push_back(level != levels->second.end() ? &level->second
-                                                       : &levels->second.at("full"));
+      if (const mesh::IndexedMesh* surface = work_mesh(bone.name)) surfaces.push_back(surface);
     }
     parallel_for(views.size(), options.threads,
                  [&](std::size_t v) { covers[v] = count_cover(surfaces, views[v]); });
@@ -138,11 +141,7 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
     if (model_tissue && !surfaces.empty()) {
       std::vector<const mesh::IndexedMesh*> muscles;
       for (const atlas::Muscle& muscle : atlas.muscles) {
-        const auto levels = meshes.find(muscle.name);
-        if (levels == meshes.end()) continue;
-        const auto level = levels->second.find(options.work_level);
-        muscles.push_back(level != levels->second.end() ? &level->second
-                                                        : &levels->second.at("full"));
+        if (const mesh::IndexedMesh* surface = work_mesh(muscle.name)) muscles.push_back(surface);
       }
       std::vector<const EdgeImage*> smooth;
       smooth.reserve(fit_views.size());

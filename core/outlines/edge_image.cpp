@@ -1,5 +1,7 @@
 #include "core/outlines/edge_image.h"
 
+#include "core/image/bilinear.h"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -83,17 +85,7 @@ EdgeImage::EdgeImage(const image::GrayImage16& radiograph, double sigma_px, doub
 }
 
 double EdgeImage::sample(const Eigen::Vector2d& pixel) const {
-  // Pixel (i, j) has its centre at (i + 0.5, j + 0.5).
-  const double x = std::clamp(pixel.x() - 0.5, 0.0, smoothed_.width - 1.0);
-  const double y = std::clamp(pixel.y() - 0.5, 0.0, smoothed_.height - 1.0);
-  const int x0 = std::min(static_cast<int>(x), smoothed_.width - 2 < 0 ? 0 : smoothed_.width - 2);
-  const int y0 = std::min(static_cast<int>(y), smoothed_.height - 2 < 0 ? 0 : smoothed_.height - 2);
-  const int x1 = std::min(x0 + 1, smoothed_.width - 1);
-  const int y1 = std::min(y0 + 1, smoothed_.height - 1);
-  const double fx = x - x0;
-  const double fy = y - y0;
-  return (1 - fy) * ((1 - fx) * smoothed_.at(x0, y0) + fx * smoothed_.at(x1, y0)) +
-         fy * ((1 - fx) * smoothed_.at(x0, y1) + fx * smoothed_.at(x1, y1));
+  return image::bilinear(smoothed_, pixel);
 }
 
 std::optional<EdgeImage::Edge> EdgeImage::edge_along(const Eigen::Vector2d& p,

@@ -12,6 +12,7 @@
 
 #include "core/atlas/limb_envelope.h"
 #include "core/errors.h"
+#include "core/image/bilinear.h"
 #include "core/image/drr.h"
 #include "core/mesh/aabb_tree.h"
 #include "core/outlines/bone_cover.h"
@@ -288,24 +289,11 @@ bool SoftTissueImage::holds(double v) const {
   return rows_[static_cast<std::size_t>(below)] != 0 && rows_[static_cast<std::size_t>(above)] != 0;
 }
 
-double SoftTissueImage::bilinear(const image::FloatImage& grid,
-                                 const Eigen::Vector2d& pixel) const {
-  const double x = std::clamp(pixel.x() / factor_ - 0.5, 0.0, grid.width - 1.0);
-  const double y = std::clamp(pixel.y() / factor_ - 0.5, 0.0, grid.height - 1.0);
-  const int x0 = std::min(static_cast<int>(x), std::max(0, grid.width - 2));
-  const int y0 = std::min(static_cast<int>(y), std::max(0, grid.height - 2));
-  const int x1 = std::min(x0 + 1, grid.width - 1);
-  const int y1 = std::min(y0 + 1, grid.height - 1);
-  const double fx = x - x0;
-  const double fy = y - y0;
-  return (1 - fy) * ((1 - fx) * grid.at(x0, y0) + fx * grid.at(x1, y0)) +
-         fy * ((1 - fx) * grid.at(x0, y1) + fx * grid.at(x1, y1));
-}
-
 double SoftTissueImage::at(const Eigen::Vector2d& pixel) const {
   if (!usable_) return 0.0;
-  return offset + tissue_per_mm * bilinear(tissue_mm_, pixel) +
-         muscle_per_mm * bilinear(muscle_mm_, pixel);
+  const Eigen::Vector2d grid = pixel / static_cast<double>(factor_);
+  return offset + tissue_per_mm * image::bilinear(tissue_mm_, grid) +
+         muscle_per_mm * image::bilinear(muscle_mm_, grid);
 }
 
 double SoftTissueImage::share(double v, int blend_rows) const {

@@ -87,8 +87,6 @@ class SoftTissueImage {
   double residual_rms = 0.0;        // their residual (image units)
 
  private:
-  [[nodiscard]] double bilinear(const image::FloatImage& grid, const Eigen::Vector2d& pixel) const;
-
   image::FloatImage tissue_mm_;
   image::FloatImage muscle_mm_;
   int factor_ = 1;  // fine pixels per grid pixel
