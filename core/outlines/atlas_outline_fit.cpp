@@ -100,21 +100,33 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
   for (const OutlineFitStage& stage : options.fit.stages) {
     if (std::ranges::find(sigmas, stage.sigma_px) == sigmas.end()) sigmas.push_back(stage.sigma_px);
   }
-  std::vector<std::unique_ptr<EdgeImage>> images(views.size() * sigmas.size());
-  std::vector<image::GrayImage16> radiographs(views.size());
-  for (std::size_t v = 0; v < views.size(); ++v) radiographs[v] = pair.image(views[v].name);
-  parallel_for(images.size(), options.threads, [&](std::size_t k) {
-    images[k] =
-        std::make_unique<EdgeImage>(radiographs[k / sigmas.size()], sigmas[k % sigmas.size()]);
-  });
-  std::vector<FitView> fit_views(views.size());
-  for (std::size_t v = 0; v < views.size(); ++v) {
-    fit_views[v].view = &views[v];
+  // Per view and sigma (index v * sigmas + s), smoothed in parallel.
+  const auto smoothed = [&](const std::vector<image::GrayImage16>& radiographs) {
+    std::vector<std::unique_ptr<EdgeImage>> out(radiographs.size() * sigmas.size());
+    parallel_for(out.size(), options.threads, [&](std::size_t k) {
+      out[k] =
+          std::make_unique<EdgeImage>(radiographs[k / sigmas.size()], sigmas[k % sigmas.size()]);
+    });
+    return out;
+  };
+  // View v's image for each stage, in stage order.
+  const auto stage_edges = [&](const std::vector<std::unique_ptr<EdgeImage>>& smooth,
+                               std::size_t v) {
+    std::vector<const EdgeImage*> edges;
     for (const OutlineFitStage& stage : options.fit.stages) {
       const auto s =
           static_cast<std::size_t>(std::ranges::find(sigmas, stage.sigma_px) - sigmas.begin());
-      fit_views[v].edges.push_back(images[v * sigmas.size() + s].get());
+      edges.push_back(smooth[v * sigmas.size() + s].get());
     }
+    return edges;
+  };
+  std::vector<image::GrayImage16> radiographs(views.size());
+  for (std::size_t v = 0; v < views.size(); ++v) radiographs[v] = pair.image(views[v].name);
+  const std::vector<std::unique_ptr<EdgeImage>> images = smoothed(radiographs);
+  std::vector<FitView> fit_views(views.size());
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    fit_views[v].view = &views[v];
+    fit_views[v].edges = stage_edges(images, v);
   }
   // Where the bones lie on each view at the start, for the thickness term.
   std::vector<std::vector<std::uint8_t>> covers(views.size());
@@ -163,21 +175,15 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
   std::vector<std::unique_ptr<EdgeImage>> tissue_free_images;
   std::vector<FitView> tissue_free_views;
   if (!options.tissue_free_bones.empty() && soft.size() == views.size()) {
-    tissue_free_images.resize(images.size());
-    parallel_for(images.size(), options.threads, [&](std::size_t k) {
-      const std::size_t v = k / sigmas.size();
-      tissue_free_images[k] = std::make_unique<EdgeImage>(
-          without_soft_tissue(radiographs[v], soft[v]), sigmas[k % sigmas.size()]);
+    std::vector<image::GrayImage16> tissue_free(views.size());
+    parallel_for(views.size(), options.threads, [&](std::size_t v) {
+      tissue_free[v] = without_soft_tissue(radiographs[v], soft[v]);
     });
+    tissue_free_images = smoothed(tissue_free);
     tissue_free_views = fit_views;
     for (std::size_t v = 0; v < views.size(); ++v) {
       tissue_free_views[v].soft = nullptr;
-      tissue_free_views[v].edges.clear();
-      for (const OutlineFitStage& stage : options.fit.stages) {
-        const auto s =
-            static_cast<std::size_t>(std::ranges::find(sigmas, stage.sigma_px) - sigmas.begin());
-        tissue_free_views[v].edges.push_back(tissue_free_images[v * sigmas.size() + s].get());
-      }
+      tissue_free_views[v].edges = stage_edges(tissue_free_images, v);
     }
   }
   result.images_seconds = seconds_since(start);

@@ -347,6 +347,9 @@ void SoftTissueImage::fit_law(const EdgeImage& image, const std::vector<std::uin
   usable_ = false;
   std::vector<bool> kept(pixels.size(), true);
   Eigen::Vector3d law = Eigen::Vector3d::Zero();
+  const auto residual = [&](const Pixel& pixel) {
+    return std::abs(pixel.value - law[0] - law[1] * pixel.tissue - law[2] * pixel.muscle);
+  };
   for (int round = 0; round < 3; ++round) {
     Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
     Eigen::Vector3d right = Eigen::Vector3d::Zero();
@@ -366,20 +369,14 @@ void SoftTissueImage::fit_law(const EdgeImage& image, const std::vector<std::uin
     std::vector<double> residuals;
     residuals.reserve(pixels.size());
     for (std::size_t i = 0; i < pixels.size(); ++i) {
-      if (!kept[i]) continue;
-      residuals.push_back(std::abs(pixels[i].value - law[0] - law[1] * pixels[i].tissue -
-                                   law[2] * pixels[i].muscle));
+      if (kept[i]) residuals.push_back(residual(pixels[i]));
     }
     double sum = 0.0;
     for (const double r : residuals) sum += r * r;
     residual_rms = std::sqrt(sum / static_cast<double>(residuals.size()));
     if (round == 2) break;
     const double limit = 3.0 * 1.4826 * median_of(residuals);
-    for (std::size_t i = 0; i < pixels.size(); ++i) {
-      const double r = std::abs(pixels[i].value - law[0] - law[1] * pixels[i].tissue -
-                                law[2] * pixels[i].muscle);
-      kept[i] = r <= limit;
-    }
+    for (std::size_t i = 0; i < pixels.size(); ++i) kept[i] = residual(pixels[i]) <= limit;
   }
   offset = law[0];
   tissue_per_mm = law[1];
