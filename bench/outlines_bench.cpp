@@ -66,7 +66,8 @@ fs::path out_dir() {
   return dir != nullptr ? dir : "build/bench";
 }
 
-const std::vector<std::string> kMeasured = {"femur_r", "tibia_r", "patella_r", "pelvis"};
+const std::vector<std::string> kMeasured = {"femur_r", "tibia_r", "fibula_r", "patella_r",
+                                            "pelvis"};
 const std::vector<std::string> kStation = {"femoral_head_centre_r", "patella_centre_r",
                                            "ankle_centre_r"};
 
@@ -208,6 +209,17 @@ outlines::AtlasOutlineFitOptions fit_options() {
     if (key == "all_free" && value != 0)
       options.tissue_free_bones = {"pelvis",  "pelvis_l", "sacrum",
                                    "femur_r", "tibia_r",  "fibula_r"};
+    if (key == "after" && value == 0) options.rounds.clear();
+    if (key == "after" && value == 2) options.rounds = {{"*"}, {"tibia_r"}};
+    if (key == "after" && value == 3) options.rounds = {{"*"}, {"pelvis"}};
+    if (key == "after" && value == 4)
+      options.rounds = {{"*", "tibia_r"}, {"fibula_r"}, {"tibia_r"}};
+    if (key == "after" && value == 5) options.rounds = {{"*", "tibia_r"}, {"fibula_r"}};
+    if (key == "after" && value == 6) options.rounds = {{"*", "tibia_r"}, {"fibula_r", "pelvis"}};
+    if (key == "fibula_spacing") options.node_spacing_mm["fibula_r"] = value;
+    if (key == "tibia_spacing") options.node_spacing_mm["tibia_r"] = value;
+    if (key == "pelvis_spacing") options.node_spacing_mm["pelvis"] = value;
+    if (key == "rpelvis_thick") options.thickness_factor["pelvis"] = value;
     if (key == "pelvis_thick") {
       for (const char* bone : {"pelvis", "pelvis_l", "sacrum"})
         options.thickness_factor[bone] = value;
@@ -305,13 +317,15 @@ Row measure(const Patient& patient) {
       if (std::getenv("MMM_BENCH_OUTLINE_VERBOSE") != nullptr) {
         std::cerr << patient.name << " " << bone << ": nodes " << b.nodes << ", iterations "
                   << b.iterations << (b.converged ? " converged" : "") << ", last change "
-                  << b.last_change_mm << " mm (p95 " << b.last_change_p95_mm << "), moved "
-                  << b.moved_mean_mm << " / " << b.moved_max_mm << " mm, held " << b.held_by_prior;
+                  << b.last_change_mm << " mm (p95 " << b.last_change_p95_mm << "), " << b.seconds
+                  << " s, moved " << b.moved_mean_mm << " / " << b.moved_max_mm << " mm, held "
+                  << b.held_by_prior;
         for (const auto& v : b.views) {
           std::cerr << " | " << v.view << " " << v.matched << "/" << v.contour_points << " "
                     << v.start_mean_mm << " -> " << v.mean_mm << " (p95 " << v.p95_mm << ")"
                     << " thickness " << v.thickness_samples << " rays, mean " << v.thickness_mean_mm
                     << " mm, gain " << v.thickness_gain;
+          for (const int px : b.neighbours_removed_px) std::cerr << " | neighbours " << px << " px";
         }
         std::cerr << "\n";
       }

@@ -28,6 +28,31 @@ std::string bone_list(const std::vector<std::string>& names) {
   return text;
 }
 
+// Rounds as "BONE, BONE; BONE, ..." (rounds separated by semicolons).
+std::string round_list(const std::vector<std::vector<std::string>>& rounds) {
+  std::string text;
+  for (const std::vector<std::string>& round : rounds) {
+    text += (text.empty() ? "" : "; ") + bone_list(round);
+  }
+  return text;
+}
+
+std::vector<std::vector<std::string>> rounds_from(const std::string& text) {
+  std::vector<std::vector<std::string>> rounds;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ';')) {
+    std::vector<std::string> round = split_names(item);
+    if (round.empty()) {
+      throw InvalidInputError("fit_bone_outlines: parameter 'rounds': an empty round in '" + text +
+                              "'; hint: rounds are separated by ';', bones by ',', e.g. "
+                              "\"*, tibia_r; fibula_r, pelvis\"");
+    }
+    rounds.push_back(std::move(round));
+  }
+  return rounds;
+}
+
 std::string factor_list(const std::map<std::string, double>& factors) {
   std::string text;
   for (const auto& [bone, factor] : factors) {
@@ -75,6 +100,7 @@ outlines::AtlasOutlineFitOptions options_from(const workflow::NodeContext& conte
   options.fit.robust_mm = context.number("robust_mm");
   options.fit.thickness.weight = context.number("thickness_weight");
   options.tissue_free_bones = split_names(context.text("tissue_free_bones"));
+  options.rounds = rounds_from(context.text("rounds"));
   options.threads = static_cast<int>(context.integer("threads"));
   return options;
 }
@@ -83,7 +109,8 @@ nlohmann::json fit_report(const outlines::AtlasOutlineFit& fit) {
   nlohmann::json bones = nlohmann::json::array();
   for (const outlines::BoneOutlineFit& bone : fit.bones) {
     nlohmann::json views = nlohmann::json::array();
-    for (const outlines::ViewFit& view : bone.views) {
+    for (std::size_t v = 0; v < bone.views.size(); ++v) {
+      const outlines::ViewFit& view = bone.views[v];
       views.push_back({{"view", view.view},
                        {"contour_points", view.contour_points},
                        {"matched", view.matched},
@@ -93,6 +120,8 @@ nlohmann::json fit_report(const outlines::AtlasOutlineFit& fit) {
                        {"thickness_samples", view.thickness_samples},
                        {"thickness_mean_mm", view.thickness_mean_mm},
                        {"thickness_gain", view.thickness_gain},
+                       {"neighbours_removed_px",
+                        v < bone.neighbours_removed_px.size() ? bone.neighbours_removed_px[v] : 0},
                        {"corrections", view.corrections},
                        {"correction_mean_mm", view.correction_mean_mm}});
     }
@@ -105,6 +134,7 @@ nlohmann::json fit_report(const outlines::AtlasOutlineFit& fit) {
                             {"moved_mean_mm", bone.moved_mean_mm},
                             {"moved_max_mm", bone.moved_max_mm},
                             {"held_by_prior", bone.held_by_prior},
+                            {"seconds", bone.seconds},
                             {"views", views},
                             {"pin_residual_mm", bone.pin_residual_mm}};
     // Where the images do not decide the shape, the scaled atlas's holds.
@@ -205,6 +235,12 @@ workflow::NodeSpec FitBoneOutlines::spec() {
       .param<std::string>("tissue_free_bones", bone_list(d.tissue_free_bones),
                           "Bones whose outlines are sought with the predicted soft tissue taken "
                           "out of the radiographs (comma-separated; empty: none)")
+      .param<std::string>(
+          "rounds", round_list(d.rounds),
+          "The fit's rounds, in order (';' between rounds, ',' between bones; '*': every bone "
+          "no round names; bones named nowhere come first). A later round fits its bones again "
+          "on radiographs with the other bones' latest fits taken out (needs the thickness "
+          "term); bones not fitted are ignored")
       .param<std::int64_t>("threads", d.threads, "Worker threads", {.min = 1, .max = 64})
       .output<Atlas>("atlas", "The patient's atlas with the bones fitted to the radiographs")
       .output<Report>("report", "Per bone and view: contour residuals, movement, convergence")

@@ -8,6 +8,7 @@
 #include "core/atlas/kinematic_chain.h"
 #include "core/errors.h"
 #include "core/outlines/bone_cover.h"
+#include "core/outlines/neighbour_layers.h"
 #include "core/parallel_for.h"
 
 namespace mmm::outlines {
@@ -93,6 +94,13 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
     }
   }
 
+  // An element's work level, else its full one; null when the atlas has no mesh for it.
+  const auto work_mesh = [&](const std::string& name) -> const mesh::IndexedMesh* {
+    const auto levels = meshes.find(name);
+    if (levels == meshes.end()) return nullptr;
+    const auto level = levels->second.find(options.work_level);
+    return level != levels->second.end() ? &level->second : &levels->second.at("full");
+  };
   AtlasOutlineFit result;
   auto start = std::chrono::steady_clock::now();
   // One edge image per view and distinct stage sigma.
@@ -136,13 +144,6 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
   const bool model_tissue = options.soft_tissue_model && (options.fit.thickness.weight > 0 ||
                                                           !options.tissue_free_bones.empty());
   if (options.fit.thickness.weight > 0 || model_tissue) {
-    // An element's work level, else its full one; null when the atlas has no mesh for it.
-    const auto work_mesh = [&](const std::string& name) -> const mesh::IndexedMesh* {
-      const auto levels = meshes.find(name);
-      if (levels == meshes.end()) return nullptr;
-      const auto level = levels->second.find(options.work_level);
-      return level != levels->second.end() ? &level->second : &levels->second.at("full");
-    };
     std::vector<const mesh::IndexedMesh*> surfaces;
     for (const atlas::Bone& bone : atlas.bones) {
       if (const mesh::IndexedMesh* surface = work_mesh(bone.name)) surfaces.push_back(surface);
@@ -190,15 +191,9 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
 
   start = std::chrono::steady_clock::now();
   result.bones.resize(chosen.size());
-  // Largest bones first, so that two threads end together.
-  std::vector<std::size_t> order(chosen.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::ranges::sort(order, [&](std::size_t a, std::size_t b) {
-    return meshes.at(chosen[a]->name).at("full").V.rows() >
-           meshes.at(chosen[b]->name).at("full").V.rows();
-  });
-  parallel_for(order.size(), options.threads, [&](std::size_t k) {
-    const atlas::Bone& bone = *chosen[order[k]];
+  const auto fit_one = [&](std::size_t index, const std::vector<FitView>& bone_views) {
+    const auto bone_start = std::chrono::steady_clock::now();
+    const atlas::Bone& bone = *chosen[index];
     const auto& levels = meshes.at(bone.name);
     BoneOutlineInput input;
     input.bone = bone.name;
@@ -219,16 +214,96 @@ AtlasOutlineFit fit_atlas_outlines(const atlas::Atlas& atlas, const atlas::Atlas
         factor != options.membrane_factor.end()) {
       fit.smoothness_weight *= factor->second;
     }
+    if (const auto spacing = options.node_spacing_mm.find(bone.name);
+        spacing != options.node_spacing_mm.end()) {
+      fit.node_spacing_mm = spacing->second;
+    }
     if (const auto factor = options.thickness_factor.find(bone.name);
         factor != options.thickness_factor.end()) {
       fit.thickness.weight *= factor->second;
     }
+    BoneOutlineFit fitted = fit_bone_outline(input, bone_views, fit);
+    fitted.seconds = seconds_since(bone_start);
+    return fitted;
+  };
+  const auto views_of = [&](const std::string& bone) -> const std::vector<FitView>& {
     const bool tissue_free =
         !tissue_free_views.empty() &&
-        std::ranges::find(options.tissue_free_bones, bone.name) != options.tissue_free_bones.end();
-    result.bones[order[k]] =
-        fit_bone_outline(input, tissue_free ? tissue_free_views : fit_views, fit);
-  });
+        std::ranges::find(options.tissue_free_bones, bone) != options.tissue_free_bones.end();
+    return tissue_free ? tissue_free_views : fit_views;
+  };
+  // The rounds, as indices into `chosen`: "*" stands for every bone no round
+  // names. Without the thickness term there are no gains to take a bone out
+  // with, so every bone is fitted once, in one round.
+  std::vector<std::vector<std::size_t>> plan;
+  {
+    const auto named = [&](const std::string& name) {
+      return std::ranges::any_of(options.rounds, [&](const std::vector<std::string>& round) {
+        return std::ranges::find(round, name) != round.end();
+      });
+    };
+    const bool layered = options.fit.thickness.weight > 0 && !options.rounds.empty();
+    std::vector<bool> fitted(chosen.size(), false);
+    for (const std::vector<std::string>& round : options.rounds) {
+      std::vector<std::size_t> members;
+      for (std::size_t i = 0; i < chosen.size(); ++i) {
+        const std::string& name = chosen[i]->name;
+        const bool listed = std::ranges::find(round, name) != round.end() ||
+                            (std::ranges::find(round, "*") != round.end() && !named(name));
+        if (listed && (layered || !fitted[i])) members.push_back(i);
+      }
+      for (const std::size_t i : members) fitted[i] = true;
+      if (!members.empty()) plan.push_back(std::move(members));
+    }
+    std::vector<std::size_t> rest;
+    for (std::size_t i = 0; i < chosen.size(); ++i) {
+      if (!fitted[i]) rest.push_back(i);
+    }
+    if (!rest.empty()) plan.insert(plan.begin(), std::move(rest));
+  }
+  std::vector<std::pair<std::string, const mesh::IndexedMesh*>> bone_surfaces;
+  for (const atlas::Bone& bone : atlas.bones) {
+    if (const mesh::IndexedMesh* surface = work_mesh(bone.name)) {
+      bone_surfaces.emplace_back(bone.name, surface);
+    }
+  }
+  // The layer reaches as far as the first stage's search around the bone.
+  const double margin_mm = options.fit.stages.front().reach_mm + 10.0;
+  std::vector<bool> have_fit(chosen.size(), false);
+  for (std::vector<std::size_t>& round : plan) {
+    // Largest bones first, so that two threads end together.
+    std::ranges::sort(round, [&](std::size_t a, std::size_t b) {
+      return meshes.at(chosen[a]->name).at("full").V.rows() >
+             meshes.at(chosen[b]->name).at("full").V.rows();
+    });
+    // Every bone's latest fit, taken out of the images of the others.
+    std::vector<std::pair<std::string, const BoneOutlineFit*>> done;
+    for (std::size_t i = 0; i < chosen.size(); ++i) {
+      if (have_fit[i]) done.emplace_back(chosen[i]->name, &result.bones[i]);
+    }
+    const NeighbourLayers layers(done, meshes, bone_surfaces, views);
+    std::vector<BoneOutlineFit> fits(round.size());
+    parallel_for(round.size(), options.threads, [&](std::size_t k) {
+      const std::string& name = chosen[round[k]]->name;
+      if (done.empty()) {
+        fits[k] = fit_one(round[k], views_of(name));
+        return;
+      }
+      NeighbourViews own;
+      layers.fill(own, name, *work_mesh(name), views_of(name), margin_mm);
+      fits[k] = fit_one(round[k], own.views);
+      fits[k].neighbours_removed_px = own.pixels_removed;
+      if (std::ranges::all_of(own.pixels_removed, [](int n) { return n == 0; })) {
+        fits[k].neighbours_removed_px.clear();
+      }
+    });
+    for (std::size_t k = 0; k < round.size(); ++k) {
+      const double before = have_fit[round[k]] ? result.bones[round[k]].seconds : 0.0;
+      result.bones[round[k]] = std::move(fits[k]);
+      result.bones[round[k]].seconds += before;
+      have_fit[round[k]] = true;
+    }
+  }
   result.fit_seconds = seconds_since(start);
   for (const atlas::Bone& bone : atlas.bones) {
     if (std::ranges::find(options.bones, bone.name) == options.bones.end()) {

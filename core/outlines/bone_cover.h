@@ -15,6 +15,15 @@
 
 namespace mmm::outlines {
 
+// A rectangle of an image's pixels: columns x0 .. x0 + width - 1, rows
+// y0 .. y0 + height - 1.
+struct PixelRegion {
+  int x0 = 0;
+  int y0 = 0;
+  int width = 0;
+  int height = 0;
+};
+
 class BoneCover {
  public:
   BoneCover() = default;
@@ -22,6 +31,9 @@ class BoneCover {
   BoneCover(const mesh::IndexedMesh& surface, const image::RadiographView& view);
 
   [[nodiscard]] bool covered(int x, int y) const;
+  // The projection's bounding box within the image (empty when nothing of
+  // the bone is in front of the source or in the image).
+  [[nodiscard]] PixelRegion region() const { return {x0_, y0_, width_, height_}; }
   // Adds 1 (saturating at 255) to counts[y * width + x] for every covered
   // pixel inside a width x height image.
   void add_to(std::vector<std::uint8_t>& counts, int width, int height) const;

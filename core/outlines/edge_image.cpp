@@ -12,9 +12,12 @@
 namespace mmm::outlines {
 namespace {
 
+int kernel_radius(double sigma) { return std::max(1, static_cast<int>(std::ceil(3.0 * sigma))); }
+
 // Separable Gaussian blur with the kernel cut at 3 sigma, edges clamped.
-image::FloatImage blurred(const image::GrayImage16& in, double sigma) {
-  const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma)));
+template <typename Image>
+image::FloatImage blurred(const Image& in, double sigma) {
+  const int radius = kernel_radius(sigma);
   std::vector<float> kernel(static_cast<std::size_t>(2 * radius + 1));
   double total = 0.0;
   for (std::size_t i = 0; i < kernel.size(); ++i) {
@@ -67,13 +70,15 @@ EdgeImage::EdgeImage(const image::GrayImage16& radiograph, double sigma_px, doub
     throw InvalidInputError("edge image: the system blur must be in [0, 20] px, got " +
                             std::to_string(system_blur_px));
   }
-  smoothed_ = blurred(radiograph, sigma_px);
+  const auto smoothed = std::make_shared<const image::FloatImage>(blurred(radiograph, sigma_px));
+  smoothed_ = smoothed;
+  const image::FloatImage& image = *smoothed;
   // Median gradient magnitude over every 4th pixel of every 4th row.
   std::vector<float> magnitudes;
-  for (int y = 1; y + 1 < smoothed_.height; y += 4) {
-    for (int x = 1; x + 1 < smoothed_.width; x += 4) {
-      const float gx = 0.5F * (smoothed_.at(x + 1, y) - smoothed_.at(x - 1, y));
-      const float gy = 0.5F * (smoothed_.at(x, y + 1) - smoothed_.at(x, y - 1));
+  for (int y = 1; y + 1 < image.height; y += 4) {
+    for (int x = 1; x + 1 < image.width; x += 4) {
+      const float gx = 0.5F * (image.at(x + 1, y) - image.at(x - 1, y));
+      const float gy = 0.5F * (image.at(x, y + 1) - image.at(x, y - 1));
       magnitudes.push_back(std::sqrt(gx * gx + gy * gy));
     }
   }
@@ -85,7 +90,33 @@ EdgeImage::EdgeImage(const image::GrayImage16& radiograph, double sigma_px, doub
 }
 
 double EdgeImage::sample(const Eigen::Vector2d& pixel) const {
-  return image::bilinear(smoothed_, pixel);
+  const double value = image::bilinear(*smoothed_, pixel);
+  if (!layer_) return value;
+  const Eigen::Vector2d local = pixel - layer_origin_.cast<double>();
+  // The padded layer is zero along its border, so clamping reads zero outside.
+  return value - image::bilinear(*layer_, local);
+}
+
+EdgeImage EdgeImage::without(const image::FloatImage& layer, const Eigen::Vector2i& origin) const {
+  if (layer.empty() || layer.pixels.size() != layer.sample_count()) {
+    throw InvalidInputError(
+        "edge image: the layer to subtract is empty or does not match its size");
+  }
+  if (!std::ranges::all_of(layer.pixels, [](float value) { return std::isfinite(value); })) {
+    throw InvalidInputError("edge image: the layer to subtract has a non-finite value");
+  }
+  if (layer_) throw InvalidInputError("edge image: a layer has already been subtracted");
+  // Padded by the kernel's radius and one more pixel of zeros, so that the
+  // blur spreads beyond the layer and the border stays zero.
+  const int pad = kernel_radius(sigma_px_) + 1;
+  image::FloatImage padded(layer.width + 2 * pad, layer.height + 2 * pad);
+  for (int y = 0; y < layer.height; ++y) {
+    for (int x = 0; x < layer.width; ++x) padded.at(x + pad, y + pad) = layer.at(x, y);
+  }
+  EdgeImage out = *this;
+  out.layer_ = std::make_shared<const image::FloatImage>(blurred(padded, sigma_px_));
+  out.layer_origin_ = origin - Eigen::Vector2i::Constant(pad);
+  return out;
 }
 
 std::optional<EdgeImage::Edge> EdgeImage::edge_along(const Eigen::Vector2d& p,

@@ -19,7 +19,13 @@
 // one constant serves every bone). The blur is the smoothing's and the
 // imaging system's together, sqrt(sigma^2 + system_blur^2); the edge returned
 // is the fall's position moved outward by that much.
+//
+// without() gives the same image less a layer (image units, e.g. the
+// fitted neighbouring bones' share of the radiograph), smoothed alike: the
+// smoothing is linear, so the layer alone is blurred and subtracted on
+// sampling. The two images share the smoothed radiograph.
 
+#include <memory>
 #include <optional>
 
 #include <Eigen/Core>
@@ -38,11 +44,17 @@ class EdgeImage {
   // image sampled at pixel centres and read bilinearly.
   EdgeImage(const image::GrayImage16& radiograph, double sigma_px, double system_blur_px = 0.4);
 
-  [[nodiscard]] int width() const { return smoothed_.width; }
-  [[nodiscard]] int height() const { return smoothed_.height; }
+  [[nodiscard]] int width() const { return smoothed_->width; }
+  [[nodiscard]] int height() const { return smoothed_->height; }
   [[nodiscard]] double sigma_px() const { return sigma_px_; }
-  // Bilinear sample of the smoothed image; positions outside are clamped.
+  // Bilinear sample of the smoothed image (less the layer, if any);
+  // positions outside are clamped.
   [[nodiscard]] double sample(const Eigen::Vector2d& pixel) const;
+  // This image less `layer`, whose pixel (0, 0) is this image's pixel
+  // `origin` (zero outside it). The median gradient is this image's. Throws
+  // InvalidInputError for an empty layer or a non-finite value in it.
+  [[nodiscard]] EdgeImage without(const image::FloatImage& layer,
+                                  const Eigen::Vector2i& origin) const;
   // Median over the image of the gradient magnitude (image units per pixel):
   // the scale of noise and texture against which edges are judged.
   [[nodiscard]] double median_gradient() const { return median_gradient_; }
@@ -58,7 +70,11 @@ class EdgeImage {
                                                double nearness = 0.5) const;
 
  private:
-  image::FloatImage smoothed_;
+  std::shared_ptr<const image::FloatImage> smoothed_;
+  // The subtracted layer, smoothed and padded by the kernel's radius; its
+  // pixel (0, 0) is the image's pixel layer_origin_.
+  std::shared_ptr<const image::FloatImage> layer_;
+  Eigen::Vector2i layer_origin_ = Eigen::Vector2i::Zero();
   double sigma_px_ = 1.0;
   double edge_shift_px_ = 0.0;  // kSqrtEdgeShift * total blur
   double median_gradient_ = 0.0;

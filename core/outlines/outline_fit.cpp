@@ -1,7 +1,6 @@
 #include "core/outlines/outline_fit.h"
 
 #include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +15,7 @@
 #include "core/outlines/bone_cover.h"
 #include "core/outlines/contour_points.h"
 #include "core/outlines/fit_rows.h"
+#include "core/scaling/sparse_cholesky.h"
 
 namespace mmm::outlines {
 namespace {
@@ -153,7 +153,7 @@ Eigen::VectorXd solve_rows(const std::vector<FitRow>& rows, int unknowns) {
   Eigen::SparseMatrix<double> A(static_cast<Eigen::Index>(rows.size()), unknowns);
   A.setFromTriplets(triplets.begin(), triplets.end());
   const Eigen::SparseMatrix<double> normal = A.transpose() * A;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
+  scaling::SparseCholesky solver(normal);
   if (solver.info() != Eigen::Success) {
     throw SolverError("outline fit: the normal equations could not be factorised");
   }

@@ -155,6 +155,10 @@ struct BoneOutlineFit {
   double last_change_p95_mm = 0.0;  // its 95th percentile
   int iterations = 0;
   int nodes = 0;
+  double seconds = 0.0;  // the fit's wall time
+  // Pixels of each view (in order) where fitted neighbours were taken out of
+  // the image the bone was fitted on; empty: none were.
+  std::vector<int> neighbours_removed_px;
   std::vector<double> pin_residual_mm;  // per pin, in order
 };
 

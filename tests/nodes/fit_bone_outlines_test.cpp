@@ -161,6 +161,20 @@ TEST(FitBoneOutlinesNodeTest, AMalformedMembraneFactorIsRejectedNamingTheParamet
   }
 }
 
+TEST(FitBoneOutlinesNodeTest, AnEmptyRoundIsRejectedNamingTheParameter) {
+  Fixture f;
+  for (const char* text : {"*, tibia_r;; femur_r", "*; , ", ";"}) {
+    auto params = f.params;
+    params["rounds"] = std::string(text);
+    try {
+      f.harness.run<FitBoneOutlines>(f.inputs, params);
+      ADD_FAILURE() << text << " was accepted";
+    } catch (const InvalidInputError& e) {
+      EXPECT_NE(std::string(e.what()).find("'rounds'"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(FitBoneOutlinesNodeTest, WithTheThicknessTermTheReportGivesItsSamplesAndGain) {
   Fixture f;
   auto params = f.params;

@@ -1,6 +1,7 @@
 // Outline fitting of a whole (toy) atlas: a patient whose femur is wider and
 // shifted, rendered into a calibrated pair; the fitted femur comes close to
-// it, the bones not asked for are left alone, and everything that follows the
+// it, the tibia fitted after it with the femur taken out stays right, the
+// bones not asked for are left alone, and everything that follows the
 // bones (carry_atlas) stays where an identity placement puts it.
 
 #include <gtest/gtest.h>
@@ -76,6 +77,7 @@ TEST(AtlasOutlineFitTest, AWiderFemurIsFittedAndTheBonesNotAskedForStay) {
 
   AtlasOutlineFitOptions options;
   options.bones = {"femur_r", "tibia_r"};
+  options.rounds = {{"*"}, {"tibia_r"}};
   const AtlasOutlineFit fit = fit_atlas_outlines(leg.atlas, leg.meshes, {}, pair, {}, options);
   ASSERT_EQ(fit.bones.size(), 2U);
   EXPECT_NE(std::ranges::find(fit.not_fitted, "pelvis"), fit.not_fitted.end());
@@ -90,6 +92,19 @@ TEST(AtlasOutlineFitTest, AWiderFemurIsFittedAndTheBonesNotAskedForStay) {
   EXPECT_LT(mesh::surface_distance(tibia, truth.at("tibia_r")).mean_mm, 0.3);
   for (const ViewFit& view : fit.bones[0].views) {
     EXPECT_LT(view.mean_mm, view.start_mean_mm) << view.view;
+  }
+  // The tibia is fitted after the femur, with the fitted femur taken out
+  // (they overlap at the knee in both views); the femur on the images as they
+  // are.
+  EXPECT_TRUE(fit.bones[0].neighbours_removed_px.empty());
+  ASSERT_EQ(fit.bones[1].neighbours_removed_px.size(), 2U);
+  for (const int pixels : fit.bones[1].neighbours_removed_px) EXPECT_GT(pixels, 100);
+  // Without the thickness term there is no gain to take a bone out with:
+  // every bone is fitted once.
+  options.fit.thickness.weight = 0.0;
+  const AtlasOutlineFit once = fit_atlas_outlines(leg.atlas, leg.meshes, {}, pair, {}, options);
+  for (const BoneOutlineFit& bone : once.bones) {
+    EXPECT_TRUE(bone.neighbours_removed_px.empty()) << bone.bone;
   }
 }
 
