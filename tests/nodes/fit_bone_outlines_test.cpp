@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <initializer_list>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <variant>
@@ -146,33 +147,29 @@ TEST(FitBoneOutlinesNodeTest, AnAcceptedReviewPassesTheAtlasThroughAndACorrectio
   EXPECT_TRUE(tibia_corrected) << report.dump(1);
 }
 
-TEST(FitBoneOutlinesNodeTest, AMalformedMembraneFactorIsRejectedNamingTheParameter) {
+// Each value of `parameter` is rejected before any fitting, the error naming it.
+void expect_rejected(const char* parameter, std::initializer_list<const char*> values) {
   Fixture f;
-  for (const char* text :
-       {"femur_r=abc", "femur_r=-1", "femur_r", "=2", "femur_r=2x", "femur_r=nan"}) {
+  for (const char* text : values) {
     auto params = f.params;
-    params["membrane_factors"] = std::string(text);
+    params[parameter] = std::string(text);
     try {
       f.harness.run<FitBoneOutlines>(f.inputs, params);
-      ADD_FAILURE() << text << " was accepted";
+      ADD_FAILURE() << parameter << " = " << text << " was accepted";
     } catch (const InvalidInputError& e) {
-      EXPECT_NE(std::string(e.what()).find("membrane_factors"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(std::string("'") + parameter + "'"), std::string::npos)
+          << e.what();
     }
   }
 }
 
+TEST(FitBoneOutlinesNodeTest, AMalformedMembraneFactorIsRejectedNamingTheParameter) {
+  expect_rejected("membrane_factors",
+                  {"femur_r=abc", "femur_r=-1", "femur_r", "=2", "femur_r=2x", "femur_r=nan"});
+}
+
 TEST(FitBoneOutlinesNodeTest, AnEmptyRoundIsRejectedNamingTheParameter) {
-  Fixture f;
-  for (const char* text : {"*, tibia_r;; femur_r", "*; , ", ";"}) {
-    auto params = f.params;
-    params["rounds"] = std::string(text);
-    try {
-      f.harness.run<FitBoneOutlines>(f.inputs, params);
-      ADD_FAILURE() << text << " was accepted";
-    } catch (const InvalidInputError& e) {
-      EXPECT_NE(std::string(e.what()).find("'rounds'"), std::string::npos) << e.what();
-    }
-  }
+  expect_rejected("rounds", {"*, tibia_r;; femur_r", "*; , ", ";"});
 }
 
 TEST(FitBoneOutlinesNodeTest, WithTheThicknessTermTheReportGivesItsSamplesAndGain) {
