@@ -216,6 +216,7 @@ outlines::AtlasOutlineFitOptions fit_options() {
       options.rounds = {{"*", "tibia_r"}, {"fibula_r"}, {"tibia_r"}};
     if (key == "after" && value == 5) options.rounds = {{"*", "tibia_r"}, {"fibula_r"}};
     if (key == "after" && value == 6) options.rounds = {{"*", "tibia_r"}, {"fibula_r", "pelvis"}};
+    if (key == "after" && value == 7) options.rounds = {{"*"}, {"fibula_r", "patella_r"}};
     if (key == "fibula_spacing") options.node_spacing_mm["fibula_r"] = value;
     if (key == "tibia_spacing") options.node_spacing_mm["tibia_r"] = value;
     if (key == "pelvis_spacing") options.node_spacing_mm["pelvis"] = value;
