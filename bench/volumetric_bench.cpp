@@ -1,0 +1,148 @@
+// The volumetric pathway's model at rest: every muscle of the default atlas
+// in one labelled lattice (core/volumetric/labelled_lattice.h), the bones
+// carved out, overlaps split by depth, then six tetrahedra per cell
+// (lattice_tets.h). (1) Per muscle and cell size: the segmentation's volume,
+// what the grid itself changes, what the bones and the other muscles take,
+// what regrowth gives back and how far out, and the volume kept (target:
+// within 2 % of the segmentation). (2) Google
+// Benchmark: the lattice and its tetrahedra at 3 mm.
+//
+// The table goes to stdout and $MMM_BENCH_OUT_DIR/volumetric.accuracy.{txt,json}.
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "bench/bench_main.h"
+#include "core/atlas/atlas_io.h"
+#include "core/atlas/atlas_meshes.h"
+#include "core/volumetric/labelled_lattice.h"
+#include "core/volumetric/lattice_tets.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace mmm;
+
+fs::path atlas_dir() {
+  const char* dir = std::getenv("MMM_BENCH_ATLAS");
+  return dir != nullptr ? dir : "build/atlas/vhf_right_leg";
+}
+
+struct Bodies {
+  atlas::Atlas atlas;
+  atlas::AtlasMeshes meshes;
+  std::vector<volumetric::NamedSurface> muscles;
+  std::vector<volumetric::NamedSurface> bones;
+};
+
+const Bodies& bodies() {
+  static const Bodies data = [] {
+    Bodies b;
+    b.atlas = atlas::read_atlas(atlas_dir());
+    b.meshes = atlas::read_atlas_meshes(b.atlas, atlas_dir());
+    for (const atlas::Muscle& m : b.atlas.muscles) {
+      b.muscles.push_back({m.name, &b.meshes.at(m.name).at("full")});
+    }
+    for (const atlas::Bone& bone : b.atlas.bones) {
+      b.bones.push_back({bone.name, &b.meshes.at(bone.name).at("full")});
+    }
+    return b;
+  }();
+  return data;
+}
+
+double median(std::vector<double> values) {
+  std::ranges::sort(values);
+  const std::size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+void write_accuracy_table() {
+  const Bodies& b = bodies();
+  std::ostringstream out;
+  out << std::fixed;
+  nlohmann::json document = nlohmann::json::array();
+  for (const double spacing : {3.0, 2.0}) {
+    const volumetric::LabelledLattice lattice = volumetric::build_labelled_lattice(
+        b.muscles, b.bones, {.spacing_mm = spacing, .threads = 2});
+    const volumetric::TetMesh tets = volumetric::lattice_tets(lattice);
+    out << "\nlattice " << std::setprecision(1) << spacing << " mm: " << lattice.cells.x() << " x "
+        << lattice.cells.y() << " x " << lattice.cells.z() << " cells, " << tets.V.rows()
+        << " nodes, " << tets.T.rows() << " tetrahedra\n";
+    out << std::left << std::setw(30) << "muscle" << std::right << std::setw(12) << "segm cm3"
+        << std::setw(10) << "grid %" << std::setw(10) << "bones %" << std::setw(11) << "muscles %"
+        << std::setw(11) << "regrown %" << std::setw(10) << "depth mm" << std::setw(10)
+        << "kept %" << "\n";
+    std::vector<double> changes;
+    nlohmann::json rows = nlohmann::json::array();
+    int within = 0;
+    for (const volumetric::MuscleCells& m : lattice.muscles) {
+      const double s = m.segmented_mm3;
+      out << std::left << std::setw(30) << m.name << std::right << std::setprecision(1)
+          << std::setw(12) << s / 1000.0 << std::setprecision(2) << std::setw(10)
+          << 100.0 * (m.inside_mm3 / s - 1.0) << std::setw(10) << -100.0 * m.to_bones_mm3 / s
+          << std::setw(11) << -100.0 * m.to_muscles_mm3 / s << std::setw(11)
+          << 100.0 * m.regrown_mm3 / s << std::setprecision(1) << std::setw(10)
+          << m.regrowth_depth_mm << std::setprecision(2) << std::setw(10) << 100.0 * m.change()
+          << "\n";
+      changes.push_back(std::abs(m.change()));
+      within += std::abs(m.change()) <= 0.02 ? 1 : 0;
+      rows.push_back({{"muscle", m.name},
+                      {"segmented_mm3", s},
+                      {"grid_change", m.inside_mm3 / s - 1.0},
+                      {"to_bones", m.to_bones_mm3 / s},
+                      {"to_muscles", m.to_muscles_mm3 / s},
+                      {"regrown", m.regrown_mm3 / s},
+                      {"regrowth_depth_mm", m.regrowth_depth_mm},
+                      {"change", m.change()}});
+    }
+    out << "|change|: median " << std::setprecision(2) << 100.0 * median(changes) << " %, max "
+        << 100.0 * *std::ranges::max_element(changes) << " %; within 2 %: " << within << " of "
+        << changes.size() << "\n";
+    document.push_back({{"spacing_mm", spacing},
+                        {"nodes", tets.V.rows()},
+                        {"tetrahedra", tets.T.rows()},
+                        {"muscles", rows}});
+  }
+  std::cout << out.str();
+  const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
+  const fs::path folder = out_dir != nullptr ? out_dir : ".";
+  std::ofstream(folder / "volumetric.accuracy.txt") << out.str();
+  std::ofstream(folder / "volumetric.accuracy.json") << document.dump(2) << "\n";
+}
+
+// Every atlas muscle into one lattice at 3 mm, bones carved out (2 threads).
+void BM_LabelledLattice(benchmark::State& state) {
+  const Bodies& b = bodies();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        volumetric::build_labelled_lattice(b.muscles, b.bones, {.spacing_mm = 3.0, .threads = 2}));
+  }
+}
+BENCHMARK(BM_LabelledLattice)->Unit(benchmark::kMillisecond);
+
+// Its tetrahedra (six per cell).
+void BM_LatticeTets(benchmark::State& state) {
+  const Bodies& b = bodies();
+  const volumetric::LabelledLattice lattice =
+      volumetric::build_labelled_lattice(b.muscles, b.bones, {.spacing_mm = 3.0, .threads = 2});
+  for (auto _ : state) benchmark::DoNotOptimize(volumetric::lattice_tets(lattice));
+}
+BENCHMARK(BM_LatticeTets)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return mmm::bench::run_suite(argc, argv, "mmm_bench_volumetric", write_accuracy_table);
+}
