@@ -82,8 +82,8 @@ void write_accuracy_table() {
         << " nodes, " << tets.T.rows() << " tetrahedra\n";
     out << std::left << std::setw(30) << "muscle" << std::right << std::setw(12) << "segm cm3"
         << std::setw(10) << "grid %" << std::setw(10) << "bones %" << std::setw(11) << "muscles %"
-        << std::setw(11) << "regrown %" << std::setw(10) << "depth mm" << std::setw(10)
-        << "kept %" << "\n";
+        << std::setw(11) << "regrown %" << std::setw(10) << "depth mm" << std::setw(10) << "kept %"
+        << "\n";
     std::vector<double> changes;
     nlohmann::json rows = nlohmann::json::array();
     int within = 0;

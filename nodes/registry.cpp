@@ -1,6 +1,7 @@
 #include "nodes/registry.h"
 
 #include "nodes/build_hulls.h"
+#include "nodes/build_muscle_lattice.h"
 #include "nodes/decimate_mesh.h"
 #include "nodes/decompose_fibres.h"
 #include "nodes/fit_bone_outlines.h"
@@ -33,6 +34,7 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<FitBoneOutlines>();
   registry.add<FuseMotion>();
   registry.add<BuildHulls>();
+  registry.add<BuildMuscleLattice>();
   registry.add<WrapMuscles>();
   registry.add<DecomposeFibres>();
   return registry;

@@ -56,8 +56,8 @@ Body prepare(const NamedSurface& named, const char* kind) {
 // so that it does not run along the edges of a surface built on the same
 // grid) counts entries minus exits below each cell centre.
 template <typename Inside>
-void fill_column(const Body& body, const LabelledLattice& lattice, int i, int j, int k_lo,
-                 int k_hi, const Inside& inside) {
+void fill_column(const Body& body, const LabelledLattice& lattice, int i, int j, int k_lo, int k_hi,
+                 const Inside& inside) {
   const double h = lattice.spacing_mm;
   const Vector3d centre = lattice.centre(i, j, 0);
   const Vector3d origin(centre.x() + 1.3e-6 * h, centre.y() + 0.7e-6 * h, body.box.min().z() - h);
@@ -104,7 +104,6 @@ CellRange cells_of(const Eigen::AlignedBox3d& box, const LabelledLattice& lattic
   return range;
 }
 
-
 struct Regrowth {
   std::int64_t cells = 0;
   double depth_mm = 0.0;
@@ -142,9 +141,12 @@ std::vector<Regrowth> regrow(LabelledLattice& lattice, const std::vector<Body>& 
         const std::int64_t j = (c / sx) % size.y();
         const std::int64_t k = c / sxy;
         const std::array<std::pair<bool, std::int64_t>, 6> next = {{
-            {i > 0, c - 1}, {i + 1 < sx, c + 1},
-            {j > 0, c - sx}, {j + 1 < size.y(), c + sx},
-            {k > 0, c - sxy}, {k + 1 < size.z(), c + sxy},
+            {i > 0, c - 1},
+            {i + 1 < sx, c + 1},
+            {j > 0, c - sx},
+            {j + 1 < size.y(), c + sx},
+            {k > 0, c - sxy},
+            {k + 1 < size.z(), c + sxy},
         }};
         for (const auto& [inside_grid, d] : next) {
           if (inside_grid && lattice.label[static_cast<std::size_t>(d)] == 0) frontier.push_back(d);
@@ -156,16 +158,17 @@ std::vector<Regrowth> regrow(LabelledLattice& lattice, const std::vector<Body>& 
       std::vector<std::pair<double, std::int64_t>> ranked(frontier.size());
       parallel_for(frontier.size(), options.threads, [&](std::size_t f) {
         const std::int64_t c = frontier[f];
-        const Eigen::Vector3d x = lattice.centre(static_cast<int>(c % sx),
-                                                 static_cast<int>((c / sx) % size.y()),
-                                                 static_cast<int>(c / sxy));
+        const Eigen::Vector3d x =
+            lattice.centre(static_cast<int>(c % sx), static_cast<int>((c / sx) % size.y()),
+                           static_cast<int>(c / sxy));
         ranked[f] = {std::sqrt(muscles[m].tree->closest_point(x).squared_distance), c};
       });
       std::ranges::sort(ranked);
       const auto take = static_cast<std::size_t>(
           std::min<std::int64_t>(deficit[m], static_cast<std::int64_t>(ranked.size())));
       for (std::size_t t = 0; t < take; ++t) {
-        lattice.label[static_cast<std::size_t>(ranked[t].second)] = static_cast<std::uint16_t>(m + 1);
+        lattice.label[static_cast<std::size_t>(ranked[t].second)] =
+            static_cast<std::uint16_t>(m + 1);
         cells[m].push_back(ranked[t].second);
         out[m].depth_mm = std::max(out[m].depth_mm, ranked[t].first);
       }
@@ -195,8 +198,8 @@ LabelledLattice build_labelled_lattice(const std::vector<NamedSurface>& muscles,
   }
   if (muscles.empty()) throw InvalidInputError("lattice: no muscles to fill");
   if (muscles.size() > kMaxMuscles) {
-    throw InvalidInputError("lattice: " + std::to_string(muscles.size()) +
-                            " muscles, at most " + std::to_string(kMaxMuscles));
+    throw InvalidInputError("lattice: " + std::to_string(muscles.size()) + " muscles, at most " +
+                            std::to_string(kMaxMuscles));
   }
   std::vector<Body> muscle_bodies;
   muscle_bodies.reserve(muscles.size());
@@ -220,9 +223,8 @@ LabelledLattice build_labelled_lattice(const std::vector<NamedSurface>& muscles,
   }
   if (total > options.max_cells) {
     throw InvalidInputError("lattice: the muscles' box needs more than " +
-                            std::to_string(options.max_cells) +
-                            " cells at spacing_mm " + std::to_string(options.spacing_mm) +
-                            " (choose a larger spacing)");
+                            std::to_string(options.max_cells) + " cells at spacing_mm " +
+                            std::to_string(options.spacing_mm) + " (choose a larger spacing)");
   }
   lattice.label.assign(static_cast<std::size_t>(total), 0);
   const double cell_volume = std::pow(options.spacing_mm, 3);
@@ -277,7 +279,8 @@ LabelledLattice build_labelled_lattice(const std::vector<NamedSurface>& muscles,
           depth[cell] = static_cast<float>(
               std::sqrt(muscle_bodies[owner - 1].tree->closest_point(x).squared_distance));
         }
-        const auto mine = static_cast<float>(std::sqrt(muscle.tree->closest_point(x).squared_distance));
+        const auto mine =
+            static_cast<float>(std::sqrt(muscle.tree->closest_point(x).squared_distance));
         if (mine > depth[cell]) {
           ++lost[owner - 1];
           owner = own;
@@ -288,8 +291,7 @@ LabelledLattice build_labelled_lattice(const std::vector<NamedSurface>& muscles,
       });
     });
   }
-  const std::vector<Regrowth> regrowth =
-      regrow(lattice, muscle_bodies, options, kBone);
+  const std::vector<Regrowth> regrowth = regrow(lattice, muscle_bodies, options, kBone);
   std::vector<std::int64_t> kept(n, 0);
   for (std::uint16_t& l : lattice.label) {
     if (l == kBone) {

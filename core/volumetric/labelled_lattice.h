@@ -60,13 +60,13 @@ struct NamedSurface {
 // What the lattice did to one muscle's volume (mm^3).
 struct MuscleCells {
   std::string name;
-  double segmented_mm3 = 0.0;  // enclosed by its surface
-  double inside_mm3 = 0.0;     // cells whose centre is inside it (the grid's own error)
-  double to_bones_mm3 = 0.0;   // of those, inside a bone
-  double to_muscles_mm3 = 0.0; // of those, given to a muscle it is less deep in
-  double regrown_mm3 = 0.0;    // grown back into free cells next to it
+  double segmented_mm3 = 0.0;      // enclosed by its surface
+  double inside_mm3 = 0.0;         // cells whose centre is inside it (the grid's own error)
+  double to_bones_mm3 = 0.0;       // of those, inside a bone
+  double to_muscles_mm3 = 0.0;     // of those, given to a muscle it is less deep in
+  double regrown_mm3 = 0.0;        // grown back into free cells next to it
   double regrowth_depth_mm = 0.0;  // farthest regrown cell from its surface
-  double kept_mm3 = 0.0;       // its cells in the lattice
+  double kept_mm3 = 0.0;           // its cells in the lattice
   // kept / segmented - 1: everything the lattice changed
   [[nodiscard]] double change() const { return kept_mm3 / segmented_mm3 - 1.0; }
 };

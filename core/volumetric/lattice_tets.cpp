@@ -82,16 +82,14 @@ TetMesh lattice_tets(const LabelledLattice& lattice) {
           const auto [it, added] =
               node_of.try_emplace(grid_node(ci, cj, ck), static_cast<int>(positions.size()));
           if (added) {
-            positions.push_back(lattice.origin +
-                                lattice.spacing_mm * Vector3d(ci, cj, ck));
+            positions.push_back(lattice.origin + lattice.spacing_mm * Vector3d(ci, cj, ck));
           }
           corner[static_cast<std::size_t>(c)] = it->second;
         }
         for (const std::array<int, 4>& t : kuhn) {
-          tets.push_back({corner[static_cast<std::size_t>(t[0])],
-                          corner[static_cast<std::size_t>(t[1])],
-                          corner[static_cast<std::size_t>(t[2])],
-                          corner[static_cast<std::size_t>(t[3])]});
+          tets.push_back(
+              {corner[static_cast<std::size_t>(t[0])], corner[static_cast<std::size_t>(t[1])],
+               corner[static_cast<std::size_t>(t[2])], corner[static_cast<std::size_t>(t[3])]});
           labels.push_back(label);
         }
       }

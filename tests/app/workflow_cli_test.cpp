@@ -119,12 +119,12 @@ TEST(WorkflowCliTest, NodesJsonIsMachineReadable) {
         << type["name"];
   }
   EXPECT_EQ(names, (std::vector<std::string>{
-                       "build_hulls", "decimate_mesh", "decompose_fibres", "fit_bone_outlines",
-                       "fuse_motion", "import_markups", "landmark_report", "landmark_station",
-                       "load_mesh", "load_radiographs", "measure_mesh", "outline_review",
-                       "scale_atlas", "static_trial_landmarks", "wrap_muscles"}))
+                       "build_hulls", "build_muscle_lattice", "decimate_mesh", "decompose_fibres",
+                       "fit_bone_outlines", "fuse_motion", "import_markups", "landmark_report",
+                       "landmark_station", "load_mesh", "load_radiographs", "measure_mesh",
+                       "outline_review", "scale_atlas", "static_trial_landmarks", "wrap_muscles"}))
       << "sorted by name";
-  const auto& decimate = json["node_types"][1];
+  const auto& decimate = json["node_types"][2];
   EXPECT_EQ(decimate["name"], "decimate_mesh");
   EXPECT_EQ(decimate["inputs"][0]["type"], "Mesh");
   EXPECT_EQ(decimate["params"][0]["name"], "target_faces");

@@ -24,7 +24,8 @@ std::int64_t count(const LabelledLattice& lattice, std::uint16_t label) {
 TEST(LabelledLatticeTest, ASphereKeepsItsVolume) {
   const double r = 20.0;
   const IndexedMesh sphere = mesh::make_icosphere(5, r);
-  const LabelledLattice lattice = build_labelled_lattice({{"ball", &sphere}}, {}, {.spacing_mm = 2.0});
+  const LabelledLattice lattice =
+      build_labelled_lattice({{"ball", &sphere}}, {}, {.spacing_mm = 2.0});
   const double exact = 4.0 / 3.0 * std::numbers::pi * r * r * r;
   const MuscleCells& ball = lattice.muscles.at(0);
   EXPECT_NEAR(ball.segmented_mm3 / exact, 1.0, 0.01);  // the icosphere's own facets
@@ -138,8 +139,10 @@ TEST(LabelledLatticeTest, TheResultDoesNotDependOnTheThreads) {
   const IndexedMesh b = mesh::make_icosphere(4, 12.0, {20.0, 3.0, -2.0});
   const IndexedMesh c = mesh::make_icosphere(4, 10.0, {8.0, -14.0, 5.0});
   const std::vector<NamedSurface> muscles = {{"a", &a}, {"b", &b}, {"c", &c}};
-  const LabelledLattice one = build_labelled_lattice(muscles, {}, {.spacing_mm = 1.5, .threads = 1});
-  const LabelledLattice four = build_labelled_lattice(muscles, {}, {.spacing_mm = 1.5, .threads = 4});
+  const LabelledLattice one =
+      build_labelled_lattice(muscles, {}, {.spacing_mm = 1.5, .threads = 1});
+  const LabelledLattice four =
+      build_labelled_lattice(muscles, {}, {.spacing_mm = 1.5, .threads = 4});
   EXPECT_EQ(one.label, four.label);
   for (std::size_t m = 0; m < 3; ++m) {
     EXPECT_EQ(one.muscles[m].kept_mm3, four.muscles[m].kept_mm3);
@@ -152,9 +155,8 @@ TEST(LabelledLatticeTest, BonesAreCarvedOut) {
   const IndexedMesh muscle = mesh::make_box({-20.0, -20.0, 0.0}, {20.0, 20.0, 60.0});
   IndexedMesh bone = mesh::make_cylinder(8.0, 80.0, 64);
   bone.V.col(2).array() -= 10.0;  // through the muscle from end to end
-  const LabelledLattice lattice =
-      build_labelled_lattice({{"around", &muscle}}, {{"shaft", &bone}},
-                             {.spacing_mm = 1.0, .max_regrowth_mm = 0.0});
+  const LabelledLattice lattice = build_labelled_lattice(
+      {{"around", &muscle}}, {{"shaft", &bone}}, {.spacing_mm = 1.0, .max_regrowth_mm = 0.0});
   const MuscleCells& m = lattice.muscles[0];
   // Cell centres (half-integers here) inside the 64-gon, between its
   // inscribed and circumscribed circles, times the 60 layers.
@@ -195,25 +197,33 @@ TEST(LabelledLatticeTest, BadInputIsRefusedWithItsName) {
     return std::string("no error");
   };
   EXPECT_NE(message([&] { build_labelled_lattice({}, {}); }).find("no muscles"), std::string::npos);
-  EXPECT_NE(message([&] { build_labelled_lattice({{"m", &ok}}, {}, {.spacing_mm = 0.0}); })
-                .find("spacing_mm"),
+  EXPECT_NE(message([&] {
+              build_labelled_lattice({{"m", &ok}}, {}, {.spacing_mm = 0.0});
+            }).find("spacing_mm"),
             std::string::npos);
-  EXPECT_NE(message([&] { build_labelled_lattice({{"m", &ok}}, {}, {.spacing_mm = NAN}); })
-                .find("spacing_mm"),
+  EXPECT_NE(message([&] {
+              build_labelled_lattice({{"m", &ok}}, {}, {.spacing_mm = NAN});
+            }).find("spacing_mm"),
             std::string::npos);
-  EXPECT_NE(message([&] { build_labelled_lattice({{"m", &ok}}, {}, {.padding_cells = 0}); })
-                .find("padding_cells"),
+  EXPECT_NE(message([&] {
+              build_labelled_lattice({{"m", &ok}}, {}, {.padding_cells = 0});
+            }).find("padding_cells"),
             std::string::npos);
-  EXPECT_NE(message([&] { build_labelled_lattice({{"m", &ok}}, {}, {.max_regrowth_mm = -1.0}); })
-                .find("max_regrowth_mm"),
+  EXPECT_NE(message([&] {
+              build_labelled_lattice({{"m", &ok}}, {}, {.max_regrowth_mm = -1.0});
+            }).find("max_regrowth_mm"),
             std::string::npos);
-  EXPECT_NE(message([&] { build_labelled_lattice({{"flipped", &inward}}, {}); })
-                .find("muscle 'flipped'"),
+  EXPECT_NE(message([&] {
+              build_labelled_lattice({{"flipped", &inward}}, {});
+            }).find("muscle 'flipped'"),
             std::string::npos);
-  EXPECT_NE(message([&] { build_labelled_lattice({{"m", &ok}}, {{"nan", &broken}}); })
-                .find("bone 'nan'"),
+  EXPECT_NE(message([&] {
+              build_labelled_lattice({{"m", &ok}}, {{"nan", &broken}});
+            }).find("bone 'nan'"),
             std::string::npos);
-  EXPECT_NE(message([&] { build_labelled_lattice({{"none", nullptr}}, {}); }).find("'none'"),
+  EXPECT_NE(message([&] {
+              build_labelled_lattice({{"none", nullptr}}, {});
+            }).find("'none'"),
             std::string::npos);
   EXPECT_NE(message([&] {
               build_labelled_lattice({{"m", &ok}}, {}, {.spacing_mm = 0.01, .max_cells = 1000});
@@ -241,15 +251,15 @@ TEST(LabelledLatticeRealDataTest, ThighMusclesKeepTheirVolumeWithinTwoPercent) {
   const LabelledLattice lattice =
       build_labelled_lattice(muscles, {{"femur", &femur}}, {.spacing_mm = 2.0, .threads = 2});
   for (const MuscleCells& m : lattice.muscles) {
-    EXPECT_LT(std::abs(m.change()), 0.02) << m.name << ": " << m.segmented_mm3 << " -> "
-                                          << m.kept_mm3 << " mm^3 (bone " << m.to_bones_mm3
-                                          << ", muscles " << m.to_muscles_mm3 << ", regrown "
-                                          << m.regrown_mm3 << ")";
+    EXPECT_LT(std::abs(m.change()), 0.02)
+        << m.name << ": " << m.segmented_mm3 << " -> " << m.kept_mm3 << " mm^3 (bone "
+        << m.to_bones_mm3 << ", muscles " << m.to_muscles_mm3 << ", regrown " << m.regrown_mm3
+        << ")";
   }
   const MuscleCells& vi = lattice.muscles[0];
   EXPECT_GT(vi.to_bones_mm3, 0.03 * vi.segmented_mm3);  // the overlap with the femur is there
-  EXPECT_NEAR(vi.regrown_mm3, vi.to_bones_mm3 + vi.to_muscles_mm3 - (vi.inside_mm3 - vi.segmented_mm3),
-              8.0 * 2.0);
+  EXPECT_NEAR(vi.regrown_mm3,
+              vi.to_bones_mm3 + vi.to_muscles_mm3 - (vi.inside_mm3 - vi.segmented_mm3), 8.0 * 2.0);
 }
 
 }  // namespace

@@ -31,8 +31,8 @@ std::set<std::array<int, 3>> sorted_faces(const IndexedMesh& surface) {
 TEST(LatticeTetsTest, TwoTouchingBoxesShareOneInterface) {
   const IndexedMesh a = mesh::make_box({0.0, 0.0, 0.0}, {30.0, 30.0, 30.0});
   const IndexedMesh b = mesh::make_box({30.0, 0.0, 0.0}, {60.0, 30.0, 30.0});
-  const LabelledLattice lattice =
-      build_labelled_lattice({{"a", &a}, {"b", &b}}, {}, {.spacing_mm = 3.0, .max_regrowth_mm = 0.0});
+  const LabelledLattice lattice = build_labelled_lattice(
+      {{"a", &a}, {"b", &b}}, {}, {.spacing_mm = 3.0, .max_regrowth_mm = 0.0});
   const TetMesh tets = lattice_tets(lattice);
   EXPECT_EQ(tets.T.rows(), 6 * 2 * 1000);
   const Eigen::VectorXd volumes = tet_volumes(tets);
@@ -64,7 +64,8 @@ TEST(LatticeTetsTest, TwoTouchingBoxesShareOneInterface) {
 
 TEST(LatticeTetsTest, ASphereBoundaryEnclosesItsCells) {
   const IndexedMesh sphere = mesh::make_icosphere(4, 12.0);
-  const LabelledLattice lattice = build_labelled_lattice({{"ball", &sphere}}, {}, {.spacing_mm = 1.5});
+  const LabelledLattice lattice =
+      build_labelled_lattice({{"ball", &sphere}}, {}, {.spacing_mm = 1.5});
   const TetMesh tets = lattice_tets(lattice);
   const IndexedMesh boundary = label_boundary(tets, 1);
   EXPECT_NEAR(mesh::signed_volume(boundary), lattice.muscles[0].kept_mm3, 1e-6);
