@@ -5,7 +5,8 @@
 // what the grid itself changes, what the bones and the other muscles take,
 // what regrowth gives back and how far out, and the volume kept (target:
 // within 2 % of the segmentation). (2) Google
-// Benchmark: the lattice and its tetrahedra at 3 mm.
+// Benchmark: the lattice and its tetrahedra at 3 mm; the simulation's set-up
+// and one frame at 3 and 5 mm (nodes within 2 mm of a bone driven by it).
 //
 // The table goes to stdout and $MMM_BENCH_OUT_DIR/volumetric.accuracy.{txt,json}.
 
@@ -18,6 +19,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -26,8 +28,10 @@
 #include "bench/bench_main.h"
 #include "core/atlas/atlas_io.h"
 #include "core/atlas/atlas_meshes.h"
+#include "core/mesh/aabb_tree.h"
 #include "core/volumetric/labelled_lattice.h"
 #include "core/volumetric/lattice_tets.h"
+#include "core/volumetric/tet_simulation.h"
 
 namespace {
 
@@ -140,6 +144,57 @@ void BM_LatticeTets(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(volumetric::lattice_tets(lattice));
 }
 BENCHMARK(BM_LatticeTets)->Unit(benchmark::kMillisecond);
+
+// The simulation on the atlas's lattice at `spacing` mm: nodes within 2 mm
+// of a bone follow it (a stand-in for the attachments), every bone checked.
+struct Simulated {
+  volumetric::TetMesh mesh;
+  std::vector<volumetric::DrivenNode> driven;
+  std::vector<const mesh::IndexedMesh*> bones;
+};
+
+Simulated simulated(double spacing) {
+  const Bodies& b = bodies();
+  Simulated out;
+  out.mesh = volumetric::lattice_tets(volumetric::build_labelled_lattice(
+      b.muscles, b.bones, {.spacing_mm = spacing, .threads = 2}));
+  for (const volumetric::NamedSurface& bone : b.bones) out.bones.push_back(bone.surface);
+  std::vector<std::unique_ptr<mesh::AabbTree>> trees;
+  for (const mesh::IndexedMesh* bone : out.bones)
+    trees.push_back(std::make_unique<mesh::AabbTree>(*bone));
+  for (Eigen::Index i = 0; i < out.mesh.V.rows(); ++i) {
+    for (std::size_t k = 0; k < trees.size(); ++k) {
+      if (trees[k]->closest_point_within(out.mesh.V.row(i).transpose(), 4.0)) {
+        out.driven.push_back({static_cast<int>(i), static_cast<int>(k)});
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+// Setting up the simulation (factorisation, warm-start weights, contact
+// candidates) at 3 and 5 mm.
+void BM_SimulationSetup(benchmark::State& state) {
+  const Simulated s = simulated(static_cast<double>(state.range(0)));
+  for (auto _ : state) {
+    volumetric::TetSimulation simulation(s.mesh, s.driven, s.bones, {.threads = 2});
+    benchmark::DoNotOptimize(simulation.checked_nodes());
+  }
+  state.counters["nodes"] = static_cast<double>(s.mesh.V.rows());
+  state.counters["tetrahedra"] = static_cast<double>(s.mesh.T.rows());
+}
+BENCHMARK(BM_SimulationSetup)->Arg(3)->Arg(5)->Unit(benchmark::kMillisecond);
+
+// One frame (10 local-global rounds) with the bones where they are.
+void BM_SimulationFrame(benchmark::State& state) {
+  const Simulated s = simulated(static_cast<double>(state.range(0)));
+  volumetric::TetSimulation simulation(s.mesh, s.driven, s.bones, {.threads = 2});
+  const std::vector<Eigen::Isometry3d> poses(s.bones.size(), Eigen::Isometry3d::Identity());
+  for (auto _ : state) benchmark::DoNotOptimize(simulation.step(poses).inverted);
+  state.counters["nodes"] = static_cast<double>(s.mesh.V.rows());
+}
+BENCHMARK(BM_SimulationFrame)->Arg(3)->Arg(5)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

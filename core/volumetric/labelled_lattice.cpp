@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -249,10 +250,9 @@ LabelledLattice build_labelled_lattice(const std::vector<NamedSurface>& muscles,
   // first contested (NaN until then).
   std::vector<float> depth(lattice.label.size(), std::numeric_limits<float>::quiet_NaN());
   const std::size_t n = muscle_bodies.size();
-  std::unique_ptr<std::atomic<std::int64_t>[]> inside(new std::atomic<std::int64_t>[n]);
-  std::unique_ptr<std::atomic<std::int64_t>[]> in_bone(new std::atomic<std::int64_t>[n]);
-  std::unique_ptr<std::atomic<std::int64_t>[]> lost(new std::atomic<std::int64_t>[n]);
-  for (std::size_t m = 0; m < n; ++m) inside[m] = in_bone[m] = lost[m] = 0;
+  std::vector<std::atomic<std::int64_t>> inside(n);  // value-initialised: 0
+  std::vector<std::atomic<std::int64_t>> in_bone(n);
+  std::vector<std::atomic<std::int64_t>> lost(n);
   for (std::size_t m = 0; m < n; ++m) {
     const Body& muscle = muscle_bodies[m];
     const auto own = static_cast<std::uint16_t>(m + 1);

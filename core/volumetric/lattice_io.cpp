@@ -15,9 +15,9 @@ namespace {
 constexpr std::array<char, 8> kMagic = {'M', 'M', 'M', 'L', 'A', 'T', '1', '\n'};
 
 struct Header {
-  double origin[3] = {};
+  std::array<double, 3> origin{};
   double spacing = 0.0;
-  std::int32_t cells[3] = {};
+  std::array<std::int32_t, 3> cells{};
   std::uint32_t muscles = 0;
 };
 constexpr std::uint64_t kHeaderBytes =
@@ -67,9 +67,9 @@ LabelledLattice read_lattice(const std::filesystem::path& path, std::int64_t max
   Header h;
   const bool read = size >= kHeaderBytes && in.read(magic.data(), magic.size()) &&
                     magic == kMagic &&
-                    in.read(reinterpret_cast<char*>(h.origin), sizeof(h.origin)) &&
+                    in.read(reinterpret_cast<char*>(h.origin.data()), sizeof(h.origin)) &&
                     in.read(reinterpret_cast<char*>(&h.spacing), sizeof(h.spacing)) &&
-                    in.read(reinterpret_cast<char*>(h.cells), sizeof(h.cells)) &&
+                    in.read(reinterpret_cast<char*>(h.cells.data()), sizeof(h.cells)) &&
                     in.read(reinterpret_cast<char*>(&h.muscles), sizeof(h.muscles));
   if (!read) throw IoError(path, "is not an mmm lattice (.lattice: it must start with MMMLAT1)");
   if (!std::isfinite(h.origin[0]) || !std::isfinite(h.origin[1]) || !std::isfinite(h.origin[2])) {

@@ -82,7 +82,7 @@ TetMesh lattice_tets(const LabelledLattice& lattice) {
           const auto [it, added] =
               node_of.try_emplace(grid_node(ci, cj, ck), static_cast<int>(positions.size()));
           if (added) {
-            positions.push_back(lattice.origin + lattice.spacing_mm * Vector3d(ci, cj, ck));
+            positions.emplace_back(lattice.origin + lattice.spacing_mm * Vector3d(ci, cj, ck));
           }
           corner[static_cast<std::size_t>(c)] = it->second;
         }

@@ -73,7 +73,7 @@ TEST(LatticeIoTest, BrokenFilesAreRefusedNamingTheProblem) {
   refused(patched(8 + 24, -1.0), "spacing");
   refused(patched(8 + 32, std::int32_t{-4}), "cell count");
   refused(patched(8 + 32, std::int32_t{1 << 30}), "limit");
-  refused(patched(kLabelsAt + 2 * 100, std::uint16_t{7}), "label 7");
+  refused(patched(kLabelsAt + std::size_t{200}, std::uint16_t{7}), "label 7");
   EXPECT_THROW((void)read_lattice(dir.path() / "missing.lattice"), IoError);
 }
 
