@@ -356,7 +356,7 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
   const auto outside_of = [&](std::size_t c, const Eigen::MatrixX3d& x) -> Vector3d {
     const State::Contact& k = s.contacts[c];
     const Eigen::Isometry3d& pose = poses[static_cast<std::size_t>(k.bone)];
-    const Vector3d here = x.row(k.node).transpose();
+    Vector3d here = x.row(k.node).transpose();
     const Vector3d p = pose.inverse() * here;
     const mesh::SignedDistance& bone = *s.bones[static_cast<std::size_t>(k.bone)];
     const double sd = bone.at(p);

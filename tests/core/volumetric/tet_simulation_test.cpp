@@ -17,8 +17,10 @@ using mesh::IndexedMesh;
 
 TetMesh blocks(const std::vector<std::pair<Vector3d, Vector3d>>& boxes, double spacing) {
   std::vector<IndexedMesh> surfaces;
+  surfaces.reserve(boxes.size());
   for (const auto& [lo, hi] : boxes) surfaces.push_back(mesh::make_box(lo, hi));
   std::vector<NamedSurface> named;
+  named.reserve(surfaces.size());
   for (std::size_t b = 0; b < surfaces.size(); ++b) {
     named.push_back({"block" + std::to_string(b), &surfaces[b]});
   }
@@ -37,6 +39,7 @@ std::vector<int> nodes_at(const TetMesh& mesh, int axis, double value) {
 
 std::vector<DrivenNode> driven_by(const std::vector<int>& nodes, int bone) {
   std::vector<DrivenNode> out;
+  out.reserve(nodes.size());
   for (const int n : nodes) out.push_back({n, bone});
   return out;
 }
