@@ -324,16 +324,33 @@ void wrapping_section(Page& page) {
              "Per muscle and frame: volume error, depth inside bone, time, smoothness change",
              "wrapping_report.json", "the wrapped muscles (after the motion)"});
   if (report) {
+    // Muscle-muscle depth when the wrapping measured it (muscle_penetration).
+    const bool measured = report->value("muscle_penetration_measured", false);
     std::vector<std::vector<std::string>> rows;
     for (const json& m : report->value("muscles", json::array())) {
-      rows.push_back({m.value("muscle", ""), fixed(m.value("max_abs_volume_error_percent", 0.0), 6),
-                      fixed(m.value("max_depth_mm", 0.0), 2),
-                      fixed(m.value("median_ms_per_frame", 0.0), 1)});
+      std::vector<std::string> row = {m.value("muscle", ""),
+                                      fixed(m.value("max_abs_volume_error_percent", 0.0), 6),
+                                      fixed(m.value("max_depth_mm", 0.0), 2)};
+      if (measured) row.push_back(fixed(m.value("max_depth_in_other_muscles_mm", 0.0), 2));
+      row.push_back(fixed(m.value("median_ms_per_frame", 0.0), 1));
+      rows.push_back(std::move(row));
     }
     page.paragraph("Worst frame per muscle over " + std::to_string(report->value("frames", 0)) +
                    " frames:");
-    page.add(html_table({"muscle", "volume error (%)", "depth in bone (mm)", "median ms per frame"},
-                        rows));
+    std::vector<std::string> header = {"muscle", "volume error (%)", "depth in bone (mm)"};
+    if (measured) header.emplace_back("depth in other muscles (mm)");
+    header.emplace_back("median ms per frame");
+    page.add(html_table(header, rows));
+    if (measured) {
+      page.paragraph("Deepest vertex of a muscle inside another muscle over the trial: " +
+                     fixed(report->value("max_depth_in_other_muscles_mm", 0.0), 2) +
+                     " mm (the segmentations already overlap at rest; muscles are deformed one "
+                     "by one, so nothing keeps them apart unless muscle_contacts is on).");
+    } else {
+      page.paragraph(
+          "Muscle-muscle penetration was not measured (wrap_muscles's "
+          "muscle_penetration is off).");
+    }
     wrapping_stage_times(page, *report);
   }
   page.end_section();

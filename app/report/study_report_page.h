@@ -12,8 +12,8 @@
 //               landmarks and of every surface against its ground truth
 //   motion      joint angles over the trial, the fit's coordinate ranges,
 //               marker residuals
-//   wrapping    volume error, depth in bone, time per muscle (table + plot),
-//               time per stage
+//   wrapping    volume error, depth in bone and (when measured) in other
+//               muscles, time per muscle (table + plot), time per stage
 //   fibres      a muscle with its fibres, fibre length curves over the trial
 //   provenance  mmm version, workflow hash, per node: type, version, state,
 //               seconds, cache key, parameters; inputs with their hashes
