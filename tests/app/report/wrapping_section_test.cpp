@@ -17,10 +17,11 @@ std::string report_html(const Json& wrapping) {
   const test::ScratchDir dir("report-wrapping");
   std::filesystem::create_directories(dir / "outputs");
   test::write_file(dir / "outputs" / "wrapping_report.json", wrapping.dump());
-  ReportInput input;
-  input.status = {{"state", "done"}, {"nodes", Json::array()}};
-  input.audit = Json::array();
-  input.outputs = dir / "outputs";
+  const ReportInput input{.status = {{"state", "done"}, {"nodes", Json::array()}},
+                          .audit = Json::array(),
+                          .outputs = dir / "outputs",
+                          .truth = std::nullopt,
+                          .threads = 2};
   const ReportResult result = write_study_report(input, dir / "report");
   return test::read_text(result.index);
 }
