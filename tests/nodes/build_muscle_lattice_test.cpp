@@ -21,12 +21,16 @@ namespace {
 
 using workflow::PortType;
 
+// The toy leg as an atlas artifact of the harness.
+workflow::ArtifactRef add_atlas(test::NodeHarness& harness, const mmm::test::ToyLeg& leg) {
+  atlas::write_atlas_with_meshes(leg.atlas, leg.meshes, harness.folder() / "toy");
+  return harness.add(PortType::kAtlas, pack_directory(harness.folder() / "toy"));
+}
+
 TEST(BuildMuscleLatticeNodeTest, TheToyMuscleBecomesTetrahedraOutsideTheBoneWithItsVolume) {
   test::NodeHarness harness;
   const mmm::test::ToyLeg leg = mmm::test::toy_leg();
-  atlas::write_atlas_with_meshes(leg.atlas, leg.meshes, harness.folder() / "toy");
-  const workflow::ArtifactRef atlas =
-      harness.add(PortType::kAtlas, pack_directory(harness.folder() / "toy"));
+  const workflow::ArtifactRef atlas = add_atlas(harness, leg);
   const auto outputs = harness.run<BuildMuscleLattice>(
       {{"atlas", atlas}}, {{"spacing_mm", 1.5}, {"threads", std::int64_t{2}}});
   const nlohmann::json report =
@@ -57,9 +61,7 @@ TEST(BuildMuscleLatticeNodeTest, TheToyMuscleBecomesTetrahedraOutsideTheBoneWith
 TEST(BuildMuscleLatticeNodeTest, AnUnknownMuscleIsRefusedNamingIt) {
   test::NodeHarness harness;
   const mmm::test::ToyLeg leg = mmm::test::toy_leg();
-  atlas::write_atlas_with_meshes(leg.atlas, leg.meshes, harness.folder() / "toy");
-  const workflow::ArtifactRef atlas =
-      harness.add(PortType::kAtlas, pack_directory(harness.folder() / "toy"));
+  const workflow::ArtifactRef atlas = add_atlas(harness, leg);
   try {
     harness.run<BuildMuscleLattice>({{"atlas", atlas}}, {{"muscles", std::string("soleus_x")}});
     FAIL() << "an unknown muscle was accepted";
