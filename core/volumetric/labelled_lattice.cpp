@@ -215,19 +215,14 @@ LabelledLattice build_labelled_lattice(const std::vector<NamedSurface>& muscles,
   for (const Body& body : muscle_bodies) all.extend(body.box);
   const double pad = options.padding_cells * options.spacing_mm;
   lattice.origin = all.min() - Vector3d::Constant(pad);
-  std::int64_t total = 1;
-  for (int axis = 0; axis < 3; ++axis) {
-    const double cells = std::ceil((all.sizes()[axis] + 2.0 * pad) / options.spacing_mm);
-    if (cells > static_cast<double>(options.max_cells)) total = options.max_cells + 1;
-    lattice.cells[axis] = static_cast<int>(std::min(cells, 2.0e9));
-    total = total > options.max_cells ? total : total * lattice.cells[axis];
-  }
-  if (total > options.max_cells) {
+  const Eigen::Array3d per_axis = ((all.sizes().array() + 2.0 * pad) / options.spacing_mm).ceil();
+  if (per_axis.prod() > static_cast<double>(options.max_cells)) {
     throw InvalidInputError("lattice: the muscles' box needs more than " +
                             std::to_string(options.max_cells) + " cells at spacing_mm " +
                             std::to_string(options.spacing_mm) + " (choose a larger spacing)");
   }
-  lattice.label.assign(static_cast<std::size_t>(total), 0);
+  lattice.cells = per_axis.cast<int>();
+  lattice.label.assign(static_cast<std::size_t>(per_axis.prod()), 0);
   const double cell_volume = std::pow(options.spacing_mm, 3);
 
   // Bones first: their cells are no muscle's.

@@ -1,13 +1,14 @@
 #include "core/volumetric/lattice_io.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <string>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 
 namespace mmm::volumetric {
 namespace {
@@ -24,54 +25,54 @@ constexpr std::uint64_t kHeaderBytes =
     kMagic.size() + 4 * sizeof(double) + 3 * sizeof(std::int32_t) + sizeof(std::uint32_t);
 
 template <typename T>
-void put(std::ofstream& out, const T& value) {
-  out.write(reinterpret_cast<const char*>(&value), sizeof(T));
+void append(std::string& out, const T& value) {
+  out.append(reinterpret_cast<const char*>(&value), sizeof(T));
 }
 
-std::ofstream open_for_writing(const std::filesystem::path& path) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw IoError(path, "cannot be written");
-  return out;
+void append_labels(std::string& out, const LabelledLattice& lattice) {
+  out.append(reinterpret_cast<const char*>(lattice.label.data()),
+             lattice.label.size() * sizeof(std::uint16_t));
 }
 
-void put_labels(std::ofstream& out, const LabelledLattice& lattice) {
-  out.write(reinterpret_cast<const char*>(lattice.label.data()),
-            static_cast<std::streamsize>(lattice.label.size() * sizeof(std::uint16_t)));
-}
-
-void finish(std::ofstream& out, const std::filesystem::path& path) {
-  out.flush();
-  if (!out) throw IoError(path, "could not be written in full (disk full?)");
+template <typename T>
+T take(const std::string& bytes, std::size_t& at) {
+  T value;
+  std::memcpy(&value, bytes.data() + at, sizeof(T));
+  at += sizeof(T);
+  return value;
 }
 
 }  // namespace
 
 void write_lattice(const std::filesystem::path& path, const LabelledLattice& lattice) {
-  std::ofstream out = open_for_writing(path);
-  out.write(kMagic.data(), kMagic.size());
-  for (int axis = 0; axis < 3; ++axis) put(out, lattice.origin[axis]);
-  put(out, lattice.spacing_mm);
-  for (int axis = 0; axis < 3; ++axis) put(out, static_cast<std::int32_t>(lattice.cells[axis]));
-  put(out, static_cast<std::uint32_t>(lattice.muscles.size()));
-  put_labels(out, lattice);
-  finish(out, path);
+  std::string bytes(kMagic.begin(), kMagic.end());
+  for (int axis = 0; axis < 3; ++axis) append(bytes, lattice.origin[axis]);
+  append(bytes, lattice.spacing_mm);
+  for (int axis = 0; axis < 3; ++axis)
+    append(bytes, static_cast<std::int32_t>(lattice.cells[axis]));
+  append(bytes, static_cast<std::uint32_t>(lattice.muscles.size()));
+  append_labels(bytes, lattice);
+  write_file_atomically(path, bytes, "a lattice file");
 }
 
 LabelledLattice read_lattice(const std::filesystem::path& path, std::int64_t max_cells) {
   std::error_code error;
   const std::uintmax_t size = std::filesystem::file_size(path, error);
   if (error) throw IoError(path, "cannot be read (" + error.message() + ")");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path, "cannot be opened");
-  std::array<char, 8> magic{};
+  if (size > kHeaderBytes + static_cast<std::uintmax_t>(max_cells) * sizeof(std::uint16_t)) {
+    throw IoError(path, "is " + std::to_string(size) + " bytes: more cells than the limit (" +
+                            std::to_string(max_cells) + ")");
+  }
+  const std::string bytes = read_file_bytes(path, size);
+  if (size < kHeaderBytes || !std::equal(kMagic.begin(), kMagic.end(), bytes.begin())) {
+    throw IoError(path, "is not an mmm lattice (.lattice: it must start with MMMLAT1)");
+  }
+  std::size_t at = kMagic.size();
   Header h;
-  const bool read = size >= kHeaderBytes && in.read(magic.data(), magic.size()) &&
-                    magic == kMagic &&
-                    in.read(reinterpret_cast<char*>(h.origin.data()), sizeof(h.origin)) &&
-                    in.read(reinterpret_cast<char*>(&h.spacing), sizeof(h.spacing)) &&
-                    in.read(reinterpret_cast<char*>(h.cells.data()), sizeof(h.cells)) &&
-                    in.read(reinterpret_cast<char*>(&h.muscles), sizeof(h.muscles));
-  if (!read) throw IoError(path, "is not an mmm lattice (.lattice: it must start with MMMLAT1)");
+  for (double& x : h.origin) x = take<double>(bytes, at);
+  h.spacing = take<double>(bytes, at);
+  for (std::int32_t& c : h.cells) c = take<std::int32_t>(bytes, at);
+  h.muscles = take<std::uint32_t>(bytes, at);
   if (!std::isfinite(h.origin[0]) || !std::isfinite(h.origin[1]) || !std::isfinite(h.origin[2])) {
     throw IoError(path, "has a non-finite origin");
   }
@@ -97,10 +98,8 @@ LabelledLattice read_lattice(const std::filesystem::path& path, std::int64_t max
   lattice.spacing_mm = h.spacing;
   lattice.cells = {h.cells[0], h.cells[1], h.cells[2]};
   lattice.label.resize(static_cast<std::size_t>(total));
-  if (!in.read(reinterpret_cast<char*>(lattice.label.data()),
-               static_cast<std::streamsize>(lattice.label.size() * sizeof(std::uint16_t)))) {
-    throw IoError(path, "could not be read in full");
-  }
+  std::memcpy(lattice.label.data(), bytes.data() + at,
+              lattice.label.size() * sizeof(std::uint16_t));
   for (std::size_t c = 0; c < lattice.label.size(); ++c) {
     if (lattice.label[c] > h.muscles) {
       throw IoError(path, "cell " + std::to_string(c) + " has label " +
@@ -129,12 +128,11 @@ void write_lattice_vti(const std::filesystem::path& path, const LabelledLattice&
       << "    </Piece>\n"
       << "  </ImageData>\n"
       << "  <AppendedData encoding=\"raw\">\n   _";
-  std::ofstream out = open_for_writing(path);
-  out << xml.str();
-  put(out, static_cast<std::uint64_t>(lattice.label.size() * sizeof(std::uint16_t)));
-  put_labels(out, lattice);
-  out << "\n  </AppendedData>\n</VTKFile>\n";
-  finish(out, path);
+  std::string bytes = xml.str();
+  append(bytes, static_cast<std::uint64_t>(lattice.label.size() * sizeof(std::uint16_t)));
+  append_labels(bytes, lattice);
+  bytes += "\n  </AppendedData>\n</VTKFile>\n";
+  write_file_atomically(path, bytes, "a lattice image");
 }
 
 }  // namespace mmm::volumetric

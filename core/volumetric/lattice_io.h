@@ -18,18 +18,19 @@
 
 namespace mmm::volumetric {
 
-// Throws IoError when the file cannot be written.
+// Written atomically (core/file_bytes.h). Throws IoError when the file cannot
+// be written.
 void write_lattice(const std::filesystem::path& path, const LabelledLattice& lattice);
 
-// Throws IoError (path first) for a missing file, a file that is not a
+// Throws IoError (path first) for a missing file, a file larger than
+// max_cells labels need (checked before it is read), a file that is not a
 // .lattice (magic), a non-finite origin, a non-positive spacing, a
-// non-positive cell count or more cells than max_cells (checked before the
-// labels are read), a size that disagrees with the header, or a label above
-// the number of muscles.
+// non-positive cell count or more cells than max_cells, a size that
+// disagrees with the header, or a label above the number of muscles.
 LabelledLattice read_lattice(const std::filesystem::path& path,
                              std::int64_t max_cells = 200'000'000);
 
-// Throws IoError when the file cannot be written.
+// Written atomically. Throws IoError when the file cannot be written.
 void write_lattice_vti(const std::filesystem::path& path, const LabelledLattice& lattice);
 
 }  // namespace mmm::volumetric

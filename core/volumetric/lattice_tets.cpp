@@ -146,26 +146,4 @@ mesh::IndexedMesh label_boundary(const TetMesh& mesh, std::uint16_t label) {
   return out;
 }
 
-mesh::IndexedMesh compact(const mesh::IndexedMesh& surface) {
-  std::vector<int> map(static_cast<std::size_t>(surface.V.rows()), -1);
-  int used = 0;
-  for (Eigen::Index f = 0; f < surface.F.rows(); ++f) {
-    for (int c = 0; c < 3; ++c) {
-      int& m = map[static_cast<std::size_t>(surface.F(f, c))];
-      if (m < 0) m = used++;
-    }
-  }
-  mesh::IndexedMesh out;
-  out.V.resize(used, 3);
-  out.F.resize(surface.F.rows(), 3);
-  for (Eigen::Index v = 0; v < surface.V.rows(); ++v) {
-    const int m = map[static_cast<std::size_t>(v)];
-    if (m >= 0) out.V.row(m) = surface.V.row(v);
-  }
-  for (Eigen::Index f = 0; f < surface.F.rows(); ++f) {
-    for (int c = 0; c < 3; ++c) out.F(f, c) = map[static_cast<std::size_t>(surface.F(f, c))];
-  }
-  return out;
-}
-
 }  // namespace mmm::volumetric

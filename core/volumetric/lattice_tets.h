@@ -38,7 +38,4 @@ Eigen::VectorXd tet_volumes(const TetMesh& mesh);
 // Throws InvalidInputError when no tetrahedron has that label.
 mesh::IndexedMesh label_boundary(const TetMesh& mesh, std::uint16_t label);
 
-// The same with only the nodes it uses (for writing and measuring).
-mesh::IndexedMesh compact(const mesh::IndexedMesh& surface);
-
 }  // namespace mmm::volumetric

@@ -266,8 +266,8 @@ TetSimulation::TetSimulation(TetMesh rest, std::vector<DrivenNode> driven,
 
   // Nodes near a bone at rest are checked against it (driven nodes follow
   // their bone and are not).
-  std::vector<char> is_driven(static_cast<std::size_t>(n), 0);
-  for (const DrivenNode& d : s.driven) is_driven[static_cast<std::size_t>(d.node)] = 1;
+  s.is_driven.assign(static_cast<std::size_t>(n), 0);
+  for (const DrivenNode& d : s.driven) s.is_driven[static_cast<std::size_t>(d.node)] = 1;
   for (std::size_t b = 0; b < s.bones.size(); ++b) {
     const double reach2 = options.contact_reach_mm * options.contact_reach_mm;
     std::vector<char> near(static_cast<std::size_t>(n), 0);
@@ -281,7 +281,7 @@ TetSimulation::TetSimulation(TetMesh rest, std::vector<DrivenNode> driven,
                     : 0;
     });
     for (std::size_t i = 0; i < near.size(); ++i) {
-      if (near[i] != 0 && is_driven[i] == 0)
+      if (near[i] != 0 && s.is_driven[i] == 0)
         s.contacts.push_back({static_cast<int>(i), static_cast<int>(b)});
     }
   }
@@ -299,7 +299,6 @@ TetSimulation::TetSimulation(TetMesh rest, std::vector<DrivenNode> driven,
   }
   s.x = s.rest.V;
   s.blend = blend_weights(s.rest, s.driven, static_cast<int>(s.bones.size()));
-  s.is_driven = is_driven;
   s.boundary.resize(s.label_volume.size());
   for (std::size_t l = 0; l < s.label_volume.size(); ++l) {
     if (s.label_volume[l] > 0) {
@@ -353,21 +352,24 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
   std::vector<Matrix3d> target_f(static_cast<std::size_t>(tets));
   // Where a checked node should be: itself when it is clear of its bone,
   // else the nearest point of the bone's surface plus the clearance.
+  // One closest-point query and one inside test per node (what
+  // SignedDistance::at does, keeping the point).
+  std::vector<Eigen::Isometry3d> inverse(poses.size());
+  for (std::size_t b = 0; b < poses.size(); ++b) inverse[b] = poses[b].inverse();
   const auto outside_of = [&](std::size_t c, const Eigen::MatrixX3d& x) -> Vector3d {
     const State::Contact& k = s.contacts[c];
-    const Eigen::Isometry3d& pose = poses[static_cast<std::size_t>(k.bone)];
+    const auto b = static_cast<std::size_t>(k.bone);
     Vector3d here = x.row(k.node).transpose();
-    const Vector3d p = pose.inverse() * here;
-    const mesh::SignedDistance& bone = *s.bones[static_cast<std::size_t>(k.bone)];
-    const double sd = bone.at(p);
-    if (sd >= o.bone_clearance_mm) return here;
-    const Vector3d on = bone.tree().closest_point(p).point;
-    Vector3d out = p - on;
-    const double length = out.norm();
+    const Vector3d p = inverse[b] * here;
+    const mesh::SignedDistance& bone = *s.bones[b];
+    const mesh::AabbTree::ClosestPoint nearest = bone.tree().closest_point(p);
+    const bool inside = bone.winding().is_inside(p);
+    const double length = std::sqrt(nearest.squared_distance);
+    if (!inside && length >= o.bone_clearance_mm) return here;
     if (length < 1e-12) return here;  // on the surface: no direction to go
-    out /= length;
-    if (sd < 0) out = -out;  // inside: the way out is towards the surface and beyond
-    return pose * (on + o.bone_clearance_mm * out);
+    Vector3d out = (p - nearest.point) / length;
+    if (inside) out = -out;  // the way out is towards the surface and beyond
+    return poses[b] * (nearest.point + o.bone_clearance_mm * out);
   };
   std::vector<Vector3d> contact_target(s.contacts.size());
   for (int iteration = 0; iteration < o.iterations; ++iteration) {
@@ -409,8 +411,7 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
   std::vector<double> depth(s.contacts.size(), 0.0);
   parallel_for(s.contacts.size(), o.threads, [&](std::size_t c) {
     const State::Contact& k = s.contacts[c];
-    const Vector3d p =
-        poses[static_cast<std::size_t>(k.bone)].inverse() * s.x.row(k.node).transpose();
+    const Vector3d p = inverse[static_cast<std::size_t>(k.bone)] * s.x.row(k.node).transpose();
     depth[c] = std::max(0.0, -s.bones[static_cast<std::size_t>(k.bone)]->at(p));
   });
   for (const double d : depth) {

@@ -41,7 +41,7 @@ TEST(LatticeTetsTest, TwoTouchingBoxesShareOneInterface) {
   const IndexedMesh boundary_a = label_boundary(tets, 1);
   const IndexedMesh boundary_b = label_boundary(tets, 2);
   for (const IndexedMesh* s : {&boundary_a, &boundary_b}) {
-    const mesh::MeshCheckReport report = mesh::check_mesh(compact(*s));
+    const mesh::MeshCheckReport report = mesh::check_mesh(*s);
     EXPECT_TRUE(report.closed());
     EXPECT_TRUE(report.orientation_consistent());
     EXPECT_NEAR(mesh::signed_volume(*s), 27000.0, 1e-6);  // outward, exactly the cells
@@ -70,7 +70,7 @@ TEST(LatticeTetsTest, ASphereBoundaryEnclosesItsCells) {
   const IndexedMesh boundary = label_boundary(tets, 1);
   EXPECT_NEAR(mesh::signed_volume(boundary), lattice.muscles[0].kept_mm3, 1e-6);
   EXPECT_NEAR(tet_volumes(tets).sum(), lattice.muscles[0].kept_mm3, 1e-6);
-  EXPECT_TRUE(mesh::check_mesh(compact(boundary)).closed());
+  EXPECT_TRUE(mesh::check_mesh(boundary).closed());
   EXPECT_THROW((void)label_boundary(tets, 2), InvalidInputError);
 }
 
