@@ -148,23 +148,25 @@ BENCHMARK(BM_LatticeTets)->Unit(benchmark::kMillisecond);
 // The simulation on the atlas's lattice at `spacing` mm: nodes within 2 mm
 // of a bone follow it (a stand-in for the attachments), every bone checked.
 struct Simulated {
-  volumetric::TetMesh mesh;
+  volumetric::EmbeddedModel model;
   std::vector<volumetric::DrivenNode> driven;
   std::vector<const mesh::IndexedMesh*> bones;
 };
 
-Simulated simulated(double spacing) {
+Simulated simulated(double spacing, int factor) {
   const Bodies& b = bodies();
   Simulated out;
-  out.mesh = volumetric::lattice_tets(volumetric::build_labelled_lattice(
-      b.muscles, b.bones, {.spacing_mm = spacing, .threads = 2}));
+  out.model = volumetric::embed_in_coarse_lattice(
+      volumetric::build_labelled_lattice(b.muscles, b.bones, {.spacing_mm = spacing, .threads = 2}),
+      factor);
   for (const volumetric::NamedSurface& bone : b.bones) out.bones.push_back(bone.surface);
   std::vector<std::unique_ptr<mesh::AabbTree>> trees;
   for (const mesh::IndexedMesh* bone : out.bones)
     trees.push_back(std::make_unique<mesh::AabbTree>(*bone));
-  for (Eigen::Index i = 0; i < out.mesh.V.rows(); ++i) {
+  const Eigen::MatrixX3d& nodes = out.model.output.V;
+  for (Eigen::Index i = 0; i < nodes.rows(); ++i) {
     for (std::size_t k = 0; k < trees.size(); ++k) {
-      if (trees[k]->closest_point_within(out.mesh.V.row(i).transpose(), 4.0)) {
+      if (trees[k]->closest_point_within(nodes.row(i).transpose(), 4.0)) {
         out.driven.push_back({static_cast<int>(i), static_cast<int>(k)});
         break;
       }
@@ -174,27 +176,50 @@ Simulated simulated(double spacing) {
 }
 
 // Setting up the simulation (factorisation, warm-start weights, contact
-// candidates) at 3 and 5 mm.
+// candidates): fine lattice spacing (mm) and coarsening factor.
 void BM_SimulationSetup(benchmark::State& state) {
-  const Simulated s = simulated(static_cast<double>(state.range(0)));
+  const Simulated s =
+      simulated(static_cast<double>(state.range(0)), static_cast<int>(state.range(1)));
   for (auto _ : state) {
-    volumetric::TetSimulation simulation(s.mesh, s.driven, s.bones, {.threads = 2});
+    volumetric::TetSimulation simulation(s.model, s.driven, s.bones, {.threads = 2});
     benchmark::DoNotOptimize(simulation.checked_nodes());
   }
-  state.counters["nodes"] = static_cast<double>(s.mesh.V.rows());
-  state.counters["tetrahedra"] = static_cast<double>(s.mesh.T.rows());
+  state.counters["element_nodes"] = static_cast<double>(s.model.elements.V.rows());
+  state.counters["elements"] = static_cast<double>(s.model.elements.T.rows());
+  state.counters["output_nodes"] = static_cast<double>(s.model.output.V.rows());
 }
-BENCHMARK(BM_SimulationSetup)->Arg(3)->Arg(5)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SimulationSetup)
+    ->Args({3, 1})
+    ->Args({3, 2})
+    ->Args({2, 3})
+    ->Unit(benchmark::kMillisecond);
 
-// One frame (10 local-global rounds) with the bones where they are.
+// One frame with the bones where they are (rounds: the third argument).
 void BM_SimulationFrame(benchmark::State& state) {
-  const Simulated s = simulated(static_cast<double>(state.range(0)));
-  volumetric::TetSimulation simulation(s.mesh, s.driven, s.bones, {.threads = 2});
+  const Simulated s =
+      simulated(static_cast<double>(state.range(0)), static_cast<int>(state.range(1)));
+  volumetric::TetSimulation simulation(
+      s.model, s.driven, s.bones, {.iterations = static_cast<int>(state.range(2)), .threads = 2});
   const std::vector<Eigen::Isometry3d> poses(s.bones.size(), Eigen::Isometry3d::Identity());
-  for (auto _ : state) benchmark::DoNotOptimize(simulation.step(poses).inverted);
-  state.counters["nodes"] = static_cast<double>(s.mesh.V.rows());
+  volumetric::FrameStats last;
+  for (auto _ : state) {
+    last = simulation.step(poses);
+    benchmark::DoNotOptimize(last.inverted);
+  }
+  state.counters["element_nodes"] = static_cast<double>(s.model.elements.V.rows());
+  state.counters["checked"] = simulation.checked_nodes();
+  state.counters["inverted"] = last.inverted;
+  state.counters["bone_depth_mm"] = last.max_bone_depth_mm;
+  state.counters["local_s"] = last.local_seconds;
+  state.counters["contact_s"] = last.contact_seconds;
+  state.counters["solve_s"] = last.solve_seconds;
+  state.counters["volume_s"] = last.volume_seconds;
 }
-BENCHMARK(BM_SimulationFrame)->Arg(3)->Arg(5)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SimulationFrame)
+    ->Args({3, 1, 5})
+    ->Args({3, 2, 5})
+    ->Args({2, 3, 5})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -39,6 +39,7 @@
 #include "core/opensim/osim_model.h"
 #include "core/opensim/trc.h"
 #include "core/plot/svg_plot.h"
+#include "core/volumetric/muscle_simulation.h"
 #include "core/wrapping/action_line_path.h"
 #include "core/wrapping/line_router.h"
 #include "core/wrapping/muscle_wrapping.h"
@@ -49,6 +50,7 @@ namespace {
 
 namespace motion = mmm::motion;
 namespace wrapping = mmm::wrapping;
+namespace volumetric = mmm::volumetric;
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct Models {
@@ -373,10 +375,164 @@ nlohmann::json write_trial_table(std::ostringstream& out) {
             {"whole_walk_s", 188.6}}}};
 }
 
+// The volumetric pathway over the same walk: every muscle in one
+// conforming tetrahedral model (3 mm lattice, 6 mm elements by default;
+// MMM_BENCH_VOLUMETRIC="spacing,coarsening,rounds" to try others).
+nlohmann::json write_volumetric_table(std::ostringstream& out) {
+  volumetric::MuscleSimulationOptions options;
+  if (const char* chosen = std::getenv("MMM_BENCH_VOLUMETRIC"); chosen != nullptr) {
+    char comma = 0;
+    std::istringstream(chosen) >> options.lattice.spacing_mm >> comma >> options.coarsening >>
+        comma >> options.simulation.iterations;
+  }
+  options.anchor_elements_in_bones = std::getenv("MMM_BENCH_VOLUMETRIC_NO_ANCHORS") == nullptr;
+  // MMM_BENCH_VOLUMETRIC_FRAMES: only the first n frames.
+  motion::FusedMotion walk_frames = atlas_walk();
+  if (const char* frames = std::getenv("MMM_BENCH_VOLUMETRIC_FRAMES"); frames != nullptr) {
+    const Eigen::Index n = std::min<Eigen::Index>(std::stoi(frames), walk_frames.num_frames());
+    walk_frames.times.conservativeResize(n);
+    walk_frames.coordinates.conservativeResize(n, Eigen::NoChange);
+  }
+  // MMM_BENCH_VOLUMETRIC_STILL: every frame at the atlas's rest coordinates
+  // (the model moved rigidly by the skeleton's root).
+  if (std::getenv("MMM_BENCH_VOLUMETRIC_STILL") != nullptr) {
+    for (const mmm::atlas::Joint& joint : models().atlas.joints) {
+      for (const mmm::atlas::Coordinate& coordinate : joint.coordinates) {
+        if (const auto column = walk_frames.coordinate_index(coordinate.name))
+          walk_frames.coordinates.col(*column).setConstant(coordinate.rest_value);
+      }
+    }
+  }
+  const volumetric::MuscleSimulation simulated =
+      volumetric::simulate_muscles(models().atlas, atlas_dir(), walk_frames, options);
+  const WalkSummary walk = summarise_walk(simulated.motion);
+  std::vector<double> frame_ms;
+  for (const volumetric::FrameStats& frame : simulated.frames)
+    frame_ms.push_back(1000.0 * frame.seconds);
+  const double whole =
+      simulated.setup_seconds + simulated.simulation_seconds + simulated.lines_seconds;
+  out << "\nwhole walk, volumetric pathway: " << simulated.motion.muscles.size() << " muscles x "
+      << simulated.frames.size() << " frames, lattice " << std::fixed << std::setprecision(1)
+      << simulated.spacing_mm << " mm, elements x" << simulated.coarsening << " ("
+      << simulated.element_nodes << " nodes, " << simulated.elements << " tetrahedra; "
+      << simulated.output_nodes << " output nodes, " << simulated.driven_nodes << " driven, "
+      << simulated.checked_nodes << " checked against bones, " << simulated.anchored_element_nodes
+      << " element nodes inside bones; at rest " << simulated.rest_moved_nodes
+      << " surface nodes moved out of bones by up to " << simulated.rest_moved_out_of_bones_mm
+      << " mm, " << simulated.rest_inverted_output << " fine tetrahedra inverted by it), "
+      << options.simulation.iterations << " rounds per frame, " << simulated.motion.threads
+      << " threads\n"
+      << "  worst volume error " << std::scientific << std::setprecision(1)
+      << walk.max_volume_percent << " %, deepest in bone " << std::fixed << std::setprecision(2)
+      << walk.max_depth_mm << " mm, in other muscles median / p99 / max "
+      << walk.median_muscle_depth_mm << " / " << walk.p99_muscle_depth_mm << " / "
+      << walk.max_muscle_depth_mm << " mm (" << walk.muscle_vertex_frames_deeper
+      << " vertex-frames deeper than 0.1 mm), inverted elements at worst " << simulated.max_inverted
+      << ", bending change p99 / max " << std::setprecision(0) << walk.p99_bending_percent << " / "
+      << walk.max_bending_percent << " %\n"
+      << "  time: setup " << std::setprecision(1) << simulated.setup_seconds << " s, simulation "
+      << simulated.simulation_seconds << " s (median " << std::setprecision(0)
+      << wrapping::median(frame_ms) << " ms per frame), action lines " << std::setprecision(1)
+      << simulated.lines_seconds << " s, whole walk " << whole << " s; measurements "
+      << simulated.measure_seconds << " s\n";
+  out << "  " << std::left << std::setw(30) << "muscle" << std::setw(12) << "faces" << std::setw(14)
+      << "|vol err| %" << std::setw(24) << "depth in bone mm (bone)"
+      << "depth in other muscles mm (muscle)\n";
+  nlohmann::json rows = nlohmann::json::array();
+  for (const wrapping::WrappedMuscle& muscle : simulated.motion.muscles) {
+    const wrapping::MuscleWrappingSummary summary = wrapping::summarise(muscle);
+    std::string bone;
+    std::string other;
+    double deepest_bone = -1.0;
+    double deepest_other = -1.0;
+    for (const wrapping::MuscleFrameMetrics& frame : muscle.frames) {
+      if (frame.max_depth_mm > deepest_bone) {
+        deepest_bone = frame.max_depth_mm;
+        bone = frame.deepest_bone;
+      }
+      if (frame.muscle_depth_mm > deepest_other && frame.deepest_muscle >= 0) {
+        deepest_other = frame.muscle_depth_mm;
+        other = simulated.motion.muscles[static_cast<std::size_t>(frame.deepest_muscle)].name;
+      }
+    }
+    std::ostringstream depth;
+    depth << std::fixed << std::setprecision(2) << summary.max_depth_mm << " (" << bone << ")";
+    const auto index = static_cast<std::size_t>(&muscle - simulated.motion.muscles.data());
+    out << "  " << std::setw(30) << muscle.name << std::setw(12) << muscle.rest.F.rows()
+        << std::setw(14) << std::scientific << std::setprecision(1)
+        << summary.max_abs_volume_error_percent << std::fixed << std::setw(24) << depth.str()
+        << std::setprecision(2) << summary.max_muscle_depth_mm << " (" << other << ")"
+        << "  attachments " << simulated.driven_per_muscle[index] << " nodes, gap "
+        << std::setprecision(1) << simulated.attachment_gap_mm[index] << " mm, left out "
+        << simulated.attachments_left_out[index] << "\n";
+    rows.push_back({{"muscle", muscle.name},
+                    {"faces", muscle.rest.F.rows()},
+                    {"max_abs_volume_error_percent", summary.max_abs_volume_error_percent},
+                    {"max_depth_mm", summary.max_depth_mm},
+                    {"deepest_bone", bone},
+                    {"max_depth_in_other_muscles_mm", summary.max_muscle_depth_mm},
+                    {"deepest_other_muscle", other}});
+  }
+  std::vector<int> inverted;
+  std::vector<int> inverted_per_muscle(simulated.motion.muscles.size(), 0);  // worst frame
+  for (const volumetric::FrameStats& frame : simulated.frames) {
+    inverted.push_back(frame.inverted);
+    for (std::size_t m = 0; m < inverted_per_muscle.size() && m < frame.inverted_per_label.size();
+         ++m) {
+      inverted_per_muscle[m] = std::max(inverted_per_muscle[m], frame.inverted_per_label[m]);
+    }
+  }
+  out << "  inverted elements per muscle, worst frame:";
+  for (std::size_t m = 0; m < inverted_per_muscle.size(); ++m) {
+    if (inverted_per_muscle[m] > 0)
+      out << " " << simulated.motion.muscles[m].name << " " << inverted_per_muscle[m];
+  }
+  out << "\n";
+  return {{"muscles", simulated.motion.muscles.size()},
+          {"per_muscle", rows},
+          {"inverted_per_frame", inverted},
+          {"frames", simulated.frames.size()},
+          {"spacing_mm", simulated.spacing_mm},
+          {"coarsening", simulated.coarsening},
+          {"rounds", options.simulation.iterations},
+          {"element_nodes", simulated.element_nodes},
+          {"elements", simulated.elements},
+          {"output_nodes", simulated.output_nodes},
+          {"driven_nodes", simulated.driven_nodes},
+          {"anchored_element_nodes", simulated.anchored_element_nodes},
+          {"rest_moved_nodes", simulated.rest_moved_nodes},
+          {"rest_moved_out_of_bones_mm", simulated.rest_moved_out_of_bones_mm},
+          {"rest_inverted_output", simulated.rest_inverted_output},
+          {"checked_nodes", simulated.checked_nodes},
+          {"threads", simulated.motion.threads},
+          {"max_abs_volume_error_percent", walk.max_volume_percent},
+          {"max_depth_mm", walk.max_depth_mm},
+          {"median_depth_in_other_muscles_mm", walk.median_muscle_depth_mm},
+          {"p99_depth_in_other_muscles_mm", walk.p99_muscle_depth_mm},
+          {"max_depth_in_other_muscles_mm", walk.max_muscle_depth_mm},
+          {"vertex_frames_deeper_in_other_muscles", walk.muscle_vertex_frames_deeper},
+          {"max_inverted_elements", simulated.max_inverted},
+          {"p99_bending_change_percent", walk.p99_bending_percent},
+          {"max_bending_change_percent", walk.max_bending_percent},
+          {"setup_s", simulated.setup_seconds},
+          {"simulation_s", simulated.simulation_seconds},
+          {"median_ms_per_frame", wrapping::median(frame_ms)},
+          {"lines_s", simulated.lines_seconds},
+          {"whole_walk_s", whole},
+          {"measurements_s", simulated.measure_seconds}};
+}
+
 void write_accuracy_table() {
   const Models& m = models();
+  // MMM_BENCH_WRAPPING_PATHWAYS: "energy", "volumetric" or both (unset).
+  const char* pathways = std::getenv("MMM_BENCH_WRAPPING_PATHWAYS");
+  const auto wanted = [&](const std::string& name) {
+    return pathways == nullptr || std::string(pathways).find(name) != std::string::npos;
+  };
   std::ostringstream trial_out;
-  const nlohmann::json trial = write_trial_table(trial_out);
+  const nlohmann::json trial = wanted("energy") ? write_trial_table(trial_out) : nlohmann::json{};
+  const nlohmann::json volumetric =
+      wanted("volumetric") ? write_volumetric_table(trial_out) : nlohmann::json{};
   std::cout << trial_out.str();
   std::vector<double> angles;
   for (int a = -20; a <= 60; a += 10) angles.push_back(a);
@@ -436,7 +592,11 @@ void write_accuracy_table() {
   const std::filesystem::path folder = out_dir != nullptr ? out_dir : ".";
   std::ofstream(folder / "wrapping.accuracy.txt") << trial_out.str() << out.str();
   std::ofstream(folder / "wrapping.accuracy.json")
-      << nlohmann::json{{"whole_walk", trial}, {"hip_flexion_moment_arms", rows}}.dump(2) << "\n";
+      << nlohmann::json{{"whole_walk", trial},
+                        {"whole_walk_volumetric", volumetric},
+                        {"hip_flexion_moment_arms", rows}}
+             .dump(2)
+      << "\n";
 }
 
 // One path and one moment arm of every atlas action line at a pose

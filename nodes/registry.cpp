@@ -12,6 +12,7 @@
 #include "nodes/load_radiographs.h"
 #include "nodes/measure_mesh.h"
 #include "nodes/scale_atlas.h"
+#include "nodes/simulate_muscles.h"
 #include "nodes/static_trial_landmarks.h"
 #include "nodes/wrap_muscles.h"
 #include "worklists/landmark_task.h"
@@ -36,6 +37,7 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<BuildHulls>();
   registry.add<BuildMuscleLattice>();
   registry.add<WrapMuscles>();
+  registry.add<SimulateMuscles>();
   registry.add<DecomposeFibres>();
   return registry;
 }

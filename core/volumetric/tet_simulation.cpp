@@ -1,6 +1,7 @@
 #include "core/volumetric/tet_simulation.h"
 
-#include <Eigen/SVD>
+#include "core/volumetric/volume_restorer.h"
+
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <chrono>
@@ -18,11 +19,12 @@
 namespace mmm::volumetric {
 namespace {
 
+using Eigen::Isometry3d;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 using Gradient = Eigen::Matrix<double, 4, 3>;
 
-constexpr int kVolumeSweeps = 3;  // d F[r, :] / d x_r of the four corners
+constexpr int kVolumeSteps = 2;  // Newton steps on the muscles' volumes per round
 
 Matrix3d edges(const Eigen::MatrixX3d& x, const TetIndices& t, Eigen::Index i) {
   Matrix3d d;
@@ -30,28 +32,27 @@ Matrix3d edges(const Eigen::MatrixX3d& x, const TetIndices& t, Eigen::Index i) {
   return d;
 }
 
-// Nearest rotation and nearest volume-preserving map of F (SVD with any
-// reflection folded into the last singular value).
-void project(const Matrix3d& f, Matrix3d& rotation, Matrix3d& volume) {
-  Eigen::JacobiSVD<Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Matrix3d u = svd.matrixU();
-  Matrix3d v = svd.matrixV();
-  Vector3d s = svd.singularValues();
-  if (u.determinant() < 0) {
-    u.col(2) *= -1.0;
-    s[2] *= -1.0;
+// The rotation of F's polar decomposition, by Mueller et al.'s iteration
+// ("A robust method to extract the rotational part of deformations", 2016)
+// from `q` (the element's rotation of the last round), and the volume-
+// preserving map F / det(F)^(1/3) (the rotation when F is inverted or flat).
+void project(const Matrix3d& f, Eigen::Quaterniond& q, int iterations, Matrix3d& rotation,
+             Matrix3d& volume) {
+  for (int i = 0; i < iterations; ++i) {
+    const Matrix3d r = q.toRotationMatrix();
+    const Vector3d omega =
+        r.col(0).cross(f.col(0)) + r.col(1).cross(f.col(1)) + r.col(2).cross(f.col(2));
+    const double denominator =
+        std::abs(r.col(0).dot(f.col(0)) + r.col(1).dot(f.col(1)) + r.col(2).dot(f.col(2))) + 1e-9;
+    const Vector3d step = omega / denominator;
+    const double angle = step.norm();
+    if (angle < 1e-9) break;
+    q = Eigen::Quaterniond(Eigen::AngleAxisd(angle, step / angle)) * q;
+    q.normalize();
   }
-  if (v.determinant() < 0) {
-    v.col(2) *= -1.0;
-    s[2] *= -1.0;
-  }
-  rotation = u * v.transpose();
-  const double product = s.prod();
-  if (product > 1e-12) {
-    volume = u * (s / std::cbrt(product)).asDiagonal() * v.transpose();
-  } else {
-    volume = rotation;  // inverted or flat: the nearest rotation is the way back
-  }
+  rotation = q.toRotationMatrix();
+  const double det = f.determinant();
+  volume = det > 1e-12 ? Matrix3d(f / std::cbrt(det)) : rotation;
 }
 
 // Per node, the bones whose driven nodes it is connected to, weighted by
@@ -116,42 +117,6 @@ std::vector<std::vector<std::pair<int, double>>> blend_weights(
   return out;
 }
 
-// One Newton step of a closed surface's volume towards `target` along its
-// gradient (dV/dx_a = (x_b x x_c) / 6 per face), moving only the nodes that
-// are not driven: x += lambda g, lambda = (target - V) / |g|^2.
-void restore_volume(Eigen::MatrixX3d& x, const Eigen::MatrixX3i& faces, double target,
-                    const std::vector<char>& fixed) {
-  double volume = 0.0;
-  std::vector<std::pair<int, Vector3d>> gradient;
-  std::vector<int> slot(static_cast<std::size_t>(x.rows()), -1);
-  const auto add = [&](int node, const Vector3d& g) {
-    int& k = slot[static_cast<std::size_t>(node)];
-    if (k < 0) {
-      k = static_cast<int>(gradient.size());
-      gradient.emplace_back(node, Vector3d::Zero());
-    }
-    gradient[static_cast<std::size_t>(k)].second += g;
-  };
-  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
-    const Vector3d a = x.row(faces(f, 0)).transpose();
-    const Vector3d b = x.row(faces(f, 1)).transpose();
-    const Vector3d c = x.row(faces(f, 2)).transpose();
-    volume += a.cross(b).dot(c) / 6.0;
-    add(faces(f, 0), b.cross(c) / 6.0);
-    add(faces(f, 1), c.cross(a) / 6.0);
-    add(faces(f, 2), a.cross(b) / 6.0);
-  }
-  double norm2 = 0.0;
-  for (const auto& [node, g] : gradient) {
-    if (fixed[static_cast<std::size_t>(node)] == 0) norm2 += g.squaredNorm();
-  }
-  if (!(norm2 > 0)) return;
-  const double lambda = (target - volume) / norm2;
-  for (const auto& [node, g] : gradient) {
-    if (fixed[static_cast<std::size_t>(node)] == 0) x.row(node) += lambda * g.transpose();
-  }
-}
-
 void require_positive(double value, const char* name) {
   if (!(value > 0) || !std::isfinite(value)) {
     throw InvalidInputError(std::string("simulation ") + name + " must be a positive number, got " +
@@ -159,49 +124,89 @@ void require_positive(double value, const char* name) {
   }
 }
 
+// The triplets of w |W_i x - target|^2 for one output node: (W_i^T W_i) w.
+void add_point_term(const EmbeddingWeights& weights, int output_node, double w,
+                    std::vector<Eigen::Triplet<double>>& triplets) {
+  for (EmbeddingWeights::InnerIterator a(weights, output_node); a; ++a) {
+    for (EmbeddingWeights::InnerIterator b(weights, output_node); b; ++b) {
+      triplets.emplace_back(static_cast<int>(a.col()), static_cast<int>(b.col()),
+                            w * a.value() * b.value());
+    }
+  }
+}
+
+// rhs += w W_i^T target.
+void add_point_rhs(const EmbeddingWeights& weights, int output_node, double w,
+                   const Vector3d& target, Eigen::MatrixX3d& rhs) {
+  for (EmbeddingWeights::InnerIterator it(weights, output_node); it; ++it)
+    rhs.row(it.col()) += w * it.value() * target.transpose();
+}
+
 }  // namespace
 
 struct TetSimulation::State {
   struct Contact {
-    int node = 0;
+    int node = 0;  // output node
     int bone = 0;
+    // Where the node was (bone frame) when its bone was last looked up, and
+    // how far it could move from there and still be clear of the bone
+    // (distance minus clearance; <= 0: not known to be clear). The signed
+    // distance changes by at most the distance moved, so until then there is
+    // no need to look again.
+    Vector3d last_point = Vector3d::Zero();
+    double clear_within = 0.0;
   };
-  TetMesh rest;
+  EmbeddedModel model;
   SimulationOptions options;
   std::vector<DrivenNode> driven;
   std::vector<std::unique_ptr<mesh::SignedDistance>> bones;
-  std::vector<Gradient> gradient;  // per tetrahedron
-  Eigen::VectorXd rest_volume;     // per tetrahedron
-  Eigen::VectorXd mass;            // per node: its share of the volume
-  std::vector<double> label_volume;
+  std::vector<Eigen::Matrix3Xd> bone_normals;  // per bone, unit face normals (rest)
+  std::vector<Gradient> gradient;              // per element
+  std::vector<Eigen::Quaterniond> rotation;    // per element, of the last round
+  Eigen::VectorXd rest_volume;                 // per element
+  Eigen::VectorXd mass;                        // per element node: its share of the volume
+  std::vector<double> label_volume;            // per label, of its output boundary at rest
   std::vector<Contact> contacts;
   scaling::SparseCholesky solver;
-  Eigen::MatrixX3d x;
-  // Warm start: each node follows a blend of the bones' motion since the
-  // last frame, weighted by how near (along the mesh's edges) it is to each
-  // bone's driven nodes.
+  Eigen::MatrixX3d x;  // element nodes
+  Eigen::MatrixX3d y;  // output nodes, W x
+  // Warm start: each element node follows a blend of the bones' motion since
+  // the last frame, weighted by how near (along the mesh's edges) it is to
+  // each bone's driven nodes.
   std::vector<std::vector<std::pair<int, double>>> blend;  // per node: (bone, weight)
   std::vector<Eigen::Isometry3d> last_poses;
-  // Per label (index label - 1): its boundary triangles, outward, on the
-  // model's nodes, for the per-muscle volume constraint.
-  std::vector<Eigen::MatrixX3i> boundary;
-  std::vector<char> is_driven;
-  double scale = 1.0;  // typical diagonal of the tetrahedra's part, for the weights
+  std::unique_ptr<VolumeRestorer> volumes;
+  double scale = 1.0;  // typical diagonal of the elements' part, for the weights
 };
 
 TetSimulation::TetSimulation(TetMesh rest, std::vector<DrivenNode> driven,
                              const std::vector<const mesh::IndexedMesh*>& bones,
                              const SimulationOptions& options)
+    : TetSimulation(embed_identity(std::move(rest)), std::move(driven), bones, options) {}
+
+TetSimulation::TetSimulation(EmbeddedModel model, std::vector<DrivenNode> driven,
+                             const std::vector<const mesh::IndexedMesh*>& bones,
+                             const SimulationOptions& options)
     : state_(std::make_unique<State>()) {
   State& s = *state_;
-  if (rest.T.rows() == 0 || rest.V.rows() == 0)
+  if (model.elements.T.rows() == 0 || model.elements.V.rows() == 0 || model.output.T.rows() == 0) {
     throw InvalidInputError("simulation: empty tet mesh");
+  }
+  if (model.weights.rows() != model.output.V.rows() ||
+      model.weights.cols() != model.elements.V.rows()) {
+    throw InvalidInputError(
+        "simulation: the embedding's weights are " + std::to_string(model.weights.rows()) + " x " +
+        std::to_string(model.weights.cols()) + " for " + std::to_string(model.output.V.rows()) +
+        " output and " + std::to_string(model.elements.V.rows()) + " element nodes");
+  }
   require_positive(options.shape_weight + options.volume_weight, "shape_weight + volume_weight");
   require_positive(options.driven_weight, "driven_weight");
   require_positive(options.inertia_weight, "inertia_weight");
   require_positive(options.contact_reach_mm, "contact_reach_mm");
   require_positive(options.contact_weight, "contact_weight");
   if (options.iterations < 1) throw InvalidInputError("simulation iterations must be at least 1");
+  if (options.rotation_iterations < 1)
+    throw InvalidInputError("simulation rotation_iterations must be at least 1");
   if (!(options.shape_weight >= 0) || !(options.volume_weight >= 0) ||
       !(options.bone_clearance_mm >= 0) || !std::isfinite(options.bone_clearance_mm)) {
     throw InvalidInputError(
@@ -209,12 +214,18 @@ TetSimulation::TetSimulation(TetMesh rest, std::vector<DrivenNode> driven,
         "be non-negative numbers");
   }
   s.options = options;
-  s.rest = std::move(rest);
+  s.model = std::move(model);
+  s.model.weights.makeCompressed();
   s.driven = std::move(driven);
-  const Eigen::Index n = s.rest.V.rows();
-  const Eigen::Index tets = s.rest.T.rows();
+  const TetMesh& elements = s.model.elements;
+  const TetMesh& output = s.model.output;
+  const EmbeddingWeights& weights = s.model.weights;
+  const Eigen::Index n = elements.V.rows();
+  const Eigen::Index outputs = output.V.rows();
+  const Eigen::Index tets = elements.T.rows();
   for (const DrivenNode& d : s.driven) {
-    if (d.node < 0 || d.node >= n || d.bone < 0 || d.bone >= static_cast<int>(bones.size())) {
+    if (d.node < 0 || d.node >= (d.element ? n : outputs) || d.bone < 0 ||
+        d.bone >= static_cast<int>(bones.size())) {
       throw InvalidInputError("simulation: driven node " + std::to_string(d.node) + " on bone " +
                               std::to_string(d.bone) + " is out of range");
     }
@@ -224,20 +235,27 @@ TetSimulation::TetSimulation(TetMesh rest, std::vector<DrivenNode> driven,
       throw InvalidInputError("simulation: bone " + std::to_string(b) + " has no surface");
     }
     s.bones.push_back(std::make_unique<mesh::SignedDistance>(*bones[b]));
+    const mesh::IndexedMesh& bone = *bones[b];
+    Eigen::Matrix3Xd normals(3, bone.F.rows());
+    for (Eigen::Index f = 0; f < bone.F.rows(); ++f) {
+      const Vector3d a = bone.V.row(bone.F(f, 0)).transpose();
+      const Vector3d e1 = bone.V.row(bone.F(f, 1)).transpose() - a;
+      const Vector3d e2 = bone.V.row(bone.F(f, 2)).transpose() - a;
+      normals.col(f) = e1.cross(e2).normalized();
+    }
+    s.bone_normals.push_back(std::move(normals));
   }
 
   s.gradient.resize(static_cast<std::size_t>(tets));
+  s.rotation.assign(static_cast<std::size_t>(tets), Eigen::Quaterniond::Identity());
   s.rest_volume.resize(tets);
   s.mass = Eigen::VectorXd::Zero(n);
-  std::uint16_t labels = 0;
-  for (const std::uint16_t l : s.rest.label) labels = std::max(labels, l);
-  s.label_volume.assign(labels, 0.0);
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(static_cast<std::size_t>(tets) * 16 + static_cast<std::size_t>(n));
   const double w = options.shape_weight + options.volume_weight;
   double diagonal = 0.0;
   for (Eigen::Index t = 0; t < tets; ++t) {
-    const Matrix3d dm = edges(s.rest.V, s.rest.T, t);
+    const Matrix3d dm = edges(elements.V, elements.T, t);
     const double volume = dm.determinant() / 6.0;
     if (!(volume > 0)) {
       throw InvalidInputError("simulation: rest tetrahedron " + std::to_string(t) +
@@ -249,12 +267,11 @@ TetSimulation::TetSimulation(TetMesh rest, std::vector<DrivenNode> driven,
     g.row(0) = -inverse.colwise().sum();
     s.gradient[static_cast<std::size_t>(t)] = g;
     s.rest_volume[t] = volume;
-    s.label_volume[s.rest.label[static_cast<std::size_t>(t)] - 1] += volume;
     const Eigen::Matrix4d block = w * volume * g * g.transpose();
     for (int a = 0; a < 4; ++a) {
-      s.mass[s.rest.T(t, a)] += volume / 4.0;
+      s.mass[elements.T(t, a)] += volume / 4.0;
       for (int b = 0; b < 4; ++b)
-        triplets.emplace_back(s.rest.T(t, a), s.rest.T(t, b), block(a, b));
+        triplets.emplace_back(elements.T(t, a), elements.T(t, b), block(a, b));
     }
     diagonal += block.trace() / 4.0;
   }
@@ -264,47 +281,79 @@ TetSimulation::TetSimulation(TetMesh rest, std::vector<DrivenNode> driven,
     triplets.emplace_back(i, i, options.inertia_weight * s.scale * s.mass[i] / mean_mass);
   }
 
-  // Nodes near a bone at rest are checked against it (driven nodes follow
-  // their bone and are not).
-  s.is_driven.assign(static_cast<std::size_t>(n), 0);
-  for (const DrivenNode& d : s.driven) s.is_driven[static_cast<std::size_t>(d.node)] = 1;
+  // The muscles' output boundaries: the volume constraint, and the nodes
+  // checked against the bones (driven nodes follow their bone and are not).
+  std::uint16_t labels = 0;
+  for (const std::uint16_t l : output.label) labels = std::max(labels, l);
+  std::vector<Eigen::MatrixX3i> boundaries(labels);
+  std::vector<char> on_boundary(static_cast<std::size_t>(outputs), 0);
+  std::vector<char> present(labels, 0);
+  for (const std::uint16_t l : output.label) present[l - 1] = 1;
+  for (std::uint16_t l = 1; l <= labels; ++l) {
+    if (present[l - 1] == 0) continue;
+    boundaries[l - 1] = label_boundary(output, l).F;
+    for (Eigen::Index f = 0; f < boundaries[l - 1].rows(); ++f) {
+      for (int c = 0; c < 3; ++c)
+        on_boundary[static_cast<std::size_t>(boundaries[l - 1](f, c))] = 1;
+    }
+  }
+  std::vector<char> is_driven(static_cast<std::size_t>(outputs), 0);
+  for (const DrivenNode& d : s.driven) {
+    if (!d.element) is_driven[static_cast<std::size_t>(d.node)] = 1;
+  }
   for (std::size_t b = 0; b < s.bones.size(); ++b) {
     const double reach2 = options.contact_reach_mm * options.contact_reach_mm;
-    std::vector<char> near(static_cast<std::size_t>(n), 0);
-    parallel_for(static_cast<std::size_t>(n), options.threads, [&](std::size_t i) {
+    std::vector<char> near(static_cast<std::size_t>(outputs), 0);
+    parallel_for(static_cast<std::size_t>(outputs), options.threads, [&](std::size_t i) {
+      if (on_boundary[i] == 0 || is_driven[i] != 0) return;
       near[i] = s.bones[b]
                         ->tree()
                         .closest_point_within(
-                            s.rest.V.row(static_cast<Eigen::Index>(i)).transpose(), reach2)
+                            output.V.row(static_cast<Eigen::Index>(i)).transpose(), reach2)
                         .has_value()
                     ? 1
                     : 0;
     });
     for (std::size_t i = 0; i < near.size(); ++i) {
-      if (near[i] != 0 && s.is_driven[i] == 0)
-        s.contacts.push_back({static_cast<int>(i), static_cast<int>(b)});
+      if (near[i] != 0) s.contacts.push_back({static_cast<int>(i), static_cast<int>(b)});
     }
   }
   for (const DrivenNode& d : s.driven) {
-    triplets.emplace_back(d.node, d.node, options.driven_weight * s.scale);
+    if (d.element) {
+      triplets.emplace_back(d.node, d.node, options.driven_weight * s.scale);
+    } else {
+      add_point_term(weights, d.node, options.driven_weight * s.scale, triplets);
+    }
   }
-  for (const State::Contact& c : s.contacts) {
-    triplets.emplace_back(c.node, c.node, options.contact_weight * s.scale);
-  }
+  for (const State::Contact& c : s.contacts)
+    add_point_term(weights, c.node, options.contact_weight * s.scale, triplets);
   Eigen::SparseMatrix<double> a(n, n);
   a.setFromTriplets(triplets.begin(), triplets.end());
   s.solver.compute(a);
   if (s.solver.info() != Eigen::Success) {
     throw SolverError("simulation: the system could not be factored (a node in no tetrahedron?)");
   }
-  s.x = s.rest.V;
-  s.blend = blend_weights(s.rest, s.driven, static_cast<int>(s.bones.size()));
-  s.boundary.resize(s.label_volume.size());
-  for (std::size_t l = 0; l < s.label_volume.size(); ++l) {
-    if (s.label_volume[l] > 0) {
-      s.boundary[l] = label_boundary(s.rest, static_cast<std::uint16_t>(l + 1)).F;
+  s.x = elements.V;
+  s.y = weights * s.x;
+  // Element nodes that carry an attachment: the seeds of the warm start's
+  // blend, and held by the volume steps.
+  std::vector<DrivenNode> seeds;
+  std::vector<char> fixed(static_cast<std::size_t>(n), 0);
+  for (const DrivenNode& d : s.driven) {
+    if (d.element) {
+      seeds.push_back(d);
+      fixed[static_cast<std::size_t>(d.node)] = 1;
+      continue;
+    }
+    for (EmbeddingWeights::InnerIterator it(weights, d.node); it; ++it) {
+      seeds.push_back({static_cast<int>(it.col()), d.bone});
+      fixed[static_cast<std::size_t>(it.col())] = 1;
     }
   }
+  s.blend = blend_weights(elements, seeds, static_cast<int>(s.bones.size()));
+  s.label_volume = boundary_volumes(boundaries, s.y);
+  s.volumes = std::make_unique<VolumeRestorer>(s.model.weights, std::move(boundaries),
+                                               s.label_volume, std::move(fixed));
   s.last_poses.assign(s.bones.size(), Eigen::Isometry3d::Identity());
 }
 
@@ -324,7 +373,9 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
       throw InvalidInputError("simulation step: a pose is not finite");
   }
   const Eigen::Index n = s.x.rows();
-  const Eigen::Index tets = s.rest.T.rows();
+  const TetMesh& elements = s.model.elements;
+  const EmbeddingWeights& weights = s.model.weights;
+  const Eigen::Index tets = elements.T.rows();
   const SimulationOptions& o = s.options;
   const Eigen::MatrixX3d previous = s.x;
   std::vector<Eigen::Isometry3d> delta(poses.size());
@@ -337,34 +388,61 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
       moved += w * (delta[static_cast<std::size_t>(bone)] * p);
     s.x.row(static_cast<Eigen::Index>(i)) = moved.transpose();
   });
+  // Each element's rotation (the polar iteration's start) turned by the
+  // motion of the bone its first corner follows most.
+  std::vector<Eigen::Quaterniond> turn(poses.size());
+  for (std::size_t b = 0; b < poses.size(); ++b) turn[b] = Eigen::Quaterniond(delta[b].rotation());
+  parallel_for(static_cast<std::size_t>(tets), o.threads, [&](std::size_t t) {
+    const auto& blend =
+        s.blend[static_cast<std::size_t>(elements.T(static_cast<Eigen::Index>(t), 0))];
+    if (blend.empty()) return;
+    const auto most = std::ranges::max_element(
+        blend, [](const auto& a, const auto& b) { return a.second < b.second; });
+    s.rotation[t] = (turn[static_cast<std::size_t>(most->first)] * s.rotation[t]).normalized();
+  });
   s.last_poses = poses;
   const double mean_mass = s.mass.mean();
-  Eigen::MatrixX3d fixed_rhs = Eigen::MatrixX3d::Zero(n, 3);
+  Eigen::MatrixX3d fixed_rhs(n, 3);
   for (Eigen::Index i = 0; i < n; ++i) {
-    fixed_rhs.row(i) = o.inertia_weight * s.scale * s.mass[i] / mean_mass * previous.row(i);
+    fixed_rhs.row(i) = o.inertia_weight * s.scale * s.mass[i] / mean_mass * s.x.row(i);
   }
   for (const DrivenNode& d : s.driven) {
-    const Vector3d target =
-        poses[static_cast<std::size_t>(d.bone)] * s.rest.V.row(d.node).transpose();
-    fixed_rhs.row(d.node) += o.driven_weight * s.scale * target.transpose();
-    s.x.row(d.node) = target.transpose();  // warm start
+    const Isometry3d& pose = poses[static_cast<std::size_t>(d.bone)];
+    if (d.element) {
+      const Vector3d target = pose * elements.V.row(d.node).transpose();
+      fixed_rhs.row(d.node) += o.driven_weight * s.scale * target.transpose();
+      s.x.row(d.node) = target.transpose();  // warm start
+    } else {
+      const Vector3d target = pose * s.model.output.V.row(d.node).transpose();
+      add_point_rhs(weights, d.node, o.driven_weight * s.scale, target, fixed_rhs);
+    }
   }
   std::vector<Matrix3d> target_f(static_cast<std::size_t>(tets));
   // Where a checked node should be: itself when it is clear of its bone,
-  // else the nearest point of the bone's surface plus the clearance.
-  // One closest-point query and one inside test per node (what
-  // SignedDistance::at does, keeping the point).
+  // else the nearest point of the bone's surface plus the clearance. One
+  // closest-point query per node that may have come near its bone since it
+  // was last looked up; inside or not from the nearest face's
+  // normal when the nearest point is inside that face, else from the
+  // winding number (edges and corners, where the normal can mislead).
   std::vector<Eigen::Isometry3d> inverse(poses.size());
   for (std::size_t b = 0; b < poses.size(); ++b) inverse[b] = poses[b].inverse();
-  const auto outside_of = [&](std::size_t c, const Eigen::MatrixX3d& x) -> Vector3d {
-    const State::Contact& k = s.contacts[c];
+  const auto outside_of = [&](std::size_t c) -> Vector3d {
+    State::Contact& k = s.contacts[c];
     const auto b = static_cast<std::size_t>(k.bone);
-    Vector3d here = x.row(k.node).transpose();
+    const Vector3d here = s.y.row(k.node).transpose();
     const Vector3d p = inverse[b] * here;
+    if (k.clear_within > 0 && (p - k.last_point).squaredNorm() < k.clear_within * k.clear_within) {
+      return here;
+    }
     const mesh::SignedDistance& bone = *s.bones[b];
     const mesh::AabbTree::ClosestPoint nearest = bone.tree().closest_point(p);
-    const bool inside = bone.winding().is_inside(p);
     const double length = std::sqrt(nearest.squared_distance);
+    constexpr double kInsideFace = 1e-3;
+    const bool inside = nearest.barycentric.minCoeff() > kInsideFace
+                            ? (p - nearest.point).dot(s.bone_normals[b].col(nearest.face)) < 0
+                            : bone.winding().is_inside(p);
+    k.last_point = p;
+    k.clear_within = inside ? 0.0 : length - o.bone_clearance_mm;
     if (!inside && length >= o.bone_clearance_mm) return here;
     if (length < 1e-12) return here;  // on the surface: no direction to go
     Vector3d out = (p - nearest.point) / length;
@@ -372,58 +450,68 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
     return poses[b] * (nearest.point + o.bone_clearance_mm * out);
   };
   std::vector<Vector3d> contact_target(s.contacts.size());
+  FrameStats stats;
+  using Clock = std::chrono::steady_clock;
+  const auto lap = [](Clock::time_point& since) {
+    const Clock::time_point now = Clock::now();
+    const double elapsed = std::chrono::duration<double>(now - since).count();
+    since = now;
+    return elapsed;
+  };
+  s.y = weights * s.x;
   for (int iteration = 0; iteration < o.iterations; ++iteration) {
+    Clock::time_point since = Clock::now();
     parallel_for(static_cast<std::size_t>(tets), o.threads, [&](std::size_t t) {
       const auto i = static_cast<Eigen::Index>(t);
       Eigen::Matrix<double, 4, 3> corners;
-      for (int a = 0; a < 4; ++a) corners.row(a) = s.x.row(s.rest.T(i, a));
+      for (int a = 0; a < 4; ++a) corners.row(a) = s.x.row(elements.T(i, a));
       const Matrix3d f = corners.transpose() * s.gradient[t];
       Matrix3d rotation;
       Matrix3d volume;
-      project(f, rotation, volume);
+      project(f, s.rotation[t], o.rotation_iterations, rotation, volume);
       target_f[t] = o.shape_weight * rotation + o.volume_weight * volume;
     });
+    stats.local_seconds += lap(since);
     parallel_for(s.contacts.size(), o.threads,
-                 [&](std::size_t c) { contact_target[c] = outside_of(c, s.x); });
+                 [&](std::size_t c) { contact_target[c] = outside_of(c); });
+    stats.contact_seconds += lap(since);
     Eigen::MatrixX3d rhs = fixed_rhs;
     for (Eigen::Index t = 0; t < tets; ++t) {
       // sum_t V_t G_t P_t^T: row a of G_t P^T goes to corner a.
       const Eigen::Matrix<double, 4, 3> part = s.rest_volume[t] *
                                                s.gradient[static_cast<std::size_t>(t)] *
                                                target_f[static_cast<std::size_t>(t)].transpose();
-      for (int a = 0; a < 4; ++a) rhs.row(s.rest.T(t, a)) += part.row(a);
+      for (int a = 0; a < 4; ++a) rhs.row(elements.T(t, a)) += part.row(a);
     }
     for (std::size_t c = 0; c < s.contacts.size(); ++c) {
-      rhs.row(s.contacts[c].node) += o.contact_weight * s.scale * contact_target[c].transpose();
+      add_point_rhs(weights, s.contacts[c].node, o.contact_weight * s.scale, contact_target[c],
+                    rhs);
     }
     s.x = s.solver.solve(rhs);
-    // Each muscle's volume back to its rest volume, muscle after muscle;
-    // shared interface nodes are moved by both, so a few sweeps.
-    for (int sweep = 0; sweep < kVolumeSweeps; ++sweep) {
-      for (std::size_t l = 0; l < s.boundary.size(); ++l) {
-        if (s.boundary[l].rows() > 0) {
-          restore_volume(s.x, s.boundary[l], s.label_volume[l], s.is_driven);
-        }
-      }
-    }
+    s.y = weights * s.x;
+    stats.solve_seconds += lap(since);
+    s.volumes->restore(s.x, s.y, kVolumeSteps, o.threads);
+    stats.volume_seconds += lap(since);
   }
-  FrameStats stats;
   std::vector<double> depth(s.contacts.size(), 0.0);
   parallel_for(s.contacts.size(), o.threads, [&](std::size_t c) {
     const State::Contact& k = s.contacts[c];
-    const Vector3d p = inverse[static_cast<std::size_t>(k.bone)] * s.x.row(k.node).transpose();
+    const Vector3d p = inverse[static_cast<std::size_t>(k.bone)] * s.y.row(k.node).transpose();
     depth[c] = std::max(0.0, -s.bones[static_cast<std::size_t>(k.bone)]->at(p));
   });
   for (const double d : depth) {
     stats.max_bone_depth_mm = std::max(stats.max_bone_depth_mm, d);
     stats.nodes_in_bones += d > 0 ? 1 : 0;
   }
-  std::vector<double> volume(s.label_volume.size(), 0.0);
+  stats.inverted_per_label.assign(s.label_volume.size(), 0);
   for (Eigen::Index t = 0; t < tets; ++t) {
-    const double v = edges(s.x, s.rest.T, t).determinant() / 6.0;
-    stats.inverted += v <= 0 ? 1 : 0;
-    volume[s.rest.label[static_cast<std::size_t>(t)] - 1] += v;
+    if (edges(s.x, elements.T, t).determinant() > 0) continue;
+    ++stats.inverted;
+    const std::uint16_t label = elements.label[static_cast<std::size_t>(t)];
+    if (label >= 1 && label <= stats.inverted_per_label.size())
+      ++stats.inverted_per_label[label - 1];
   }
+  const std::vector<double> volume = s.volumes->volumes(s.y);
   stats.volume_change.resize(volume.size());
   for (std::size_t l = 0; l < volume.size(); ++l) {
     stats.volume_change[l] = s.label_volume[l] > 0 ? volume[l] / s.label_volume[l] - 1.0 : 0.0;
@@ -432,8 +520,9 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
   return stats;
 }
 
-const Eigen::MatrixX3d& TetSimulation::positions() const { return state_->x; }
-const TetMesh& TetSimulation::rest() const { return state_->rest; }
+const Eigen::MatrixX3d& TetSimulation::positions() const { return state_->y; }
+const Eigen::MatrixX3d& TetSimulation::element_positions() const { return state_->x; }
+const EmbeddedModel& TetSimulation::model() const { return state_->model; }
 int TetSimulation::checked_nodes() const { return static_cast<int>(state_->contacts.size()); }
 
 }  // namespace mmm::volumetric
