@@ -30,7 +30,18 @@ constexpr std::uintmax_t kMaxLatticeJsonBytes = 16 << 20;
 volumetric::LabelledLattice read_lattice_bundle(const std::filesystem::path& folder) {
   volumetric::LabelledLattice lattice = volumetric::read_lattice(folder / "muscles.lattice");
   const std::filesystem::path json_path = folder / "lattice.json";
-  const std::string text = read_file_bytes(json_path, kMaxLatticeJsonBytes);
+  std::error_code error;
+  const std::uintmax_t size = std::filesystem::file_size(json_path, error);
+  if (error || !std::filesystem::is_regular_file(json_path)) {
+    throw InvalidInputError(
+        "simulate_muscles: input 'lattice' has no lattice.json; hint: connect "
+        "build_muscle_lattice's 'lattice'");
+  }
+  if (size > kMaxLatticeJsonBytes) {
+    throw InvalidInputError("simulate_muscles: input 'lattice': lattice.json is " +
+                            std::to_string(size) + " bytes, more than a lattice's summary can be");
+  }
+  const std::string text = read_file_bytes(json_path, size);
   nlohmann::json summary;
   try {
     summary = parse_json(text);
@@ -136,6 +147,9 @@ nlohmann::json report_of(const volumetric::MuscleSimulation& simulated,
         {"elements", simulated.elements},
         {"output_nodes", simulated.output_nodes},
         {"attachment_nodes", simulated.driven_nodes},
+        {"element_nodes_in_bones", simulated.anchored_element_nodes},
+        {"rest_surface_nodes_moved_out_of_bones", simulated.rest_moved_nodes},
+        {"rest_largest_move_out_of_bones_mm", simulated.rest_moved_out_of_bones_mm},
         {"nodes_checked_against_bones", simulated.checked_nodes}}},
       {"time",
        {{"setup_s", simulated.setup_seconds},

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <numbers>
 
 #include "core/errors.h"
@@ -139,6 +140,58 @@ TEST(TetSimulationTest, ABlockPushedOntoABoneStaysOutOfIt) {
   const Vector3d on_top = simulation.positions().row(centre).transpose();
   EXPECT_GT(on_top.z(), -1.0);
   EXPECT_NEAR((on_top - Vector3d(15.0, 15.0, -9.0)).norm(), 10.0, 0.5);
+}
+
+// The whole model moved rigidly in one step (the skeleton's root taking
+// the atlas into the world, say): a coarse embedding of two touching
+// blocks follows exactly, every muscle surface node included.
+TEST(TetSimulationTest, ARigidMotionOfEverythingIsReproducedExactly) {
+  std::vector<IndexedMesh> surfaces = {mesh::make_box({0, 0, 0}, {24, 24, 24}),
+                                       mesh::make_box({24, 0, 0}, {48, 24, 24})};
+  const LabelledLattice lattice = build_labelled_lattice(
+      {{"a", &surfaces[0]}, {"b", &surfaces[1]}}, {}, {.spacing_mm = 1.5, .max_regrowth_mm = 0});
+  EmbeddedModel model = embed_in_coarse_lattice(lattice, 2);
+  std::vector<DrivenNode> driven;
+  for (const double x : {0.0, 48.0}) {
+    for (Eigen::Index i = 0; i < model.output.V.rows(); ++i) {
+      if (std::abs(model.output.V(i, 0) - x) < 1e-9) driven.push_back({static_cast<int>(i), 0});
+    }
+  }
+  const Eigen::MatrixX3d rest = model.output.V;
+  TetSimulation simulation(std::move(model), driven, {&far_handle()},
+                           {.iterations = 3, .threads = 2});
+  Isometry3d pose = Isometry3d::Identity();
+  pose.rotate(Eigen::AngleAxisd(1.3, Vector3d(2, -1, 1).normalized()));
+  pose.pretranslate(Vector3d(300, -150, 80));
+  const FrameStats stats = simulation.step({pose});
+  const Eigen::MatrixX3d expected =
+      (rest * pose.linear().transpose()).rowwise() + pose.translation().transpose();
+  EXPECT_LT((simulation.positions() - expected).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_EQ(stats.inverted, 0);
+  for (const double change : stats.volume_change) EXPECT_LT(std::abs(change), 1e-9);
+}
+
+// Same inputs, same outputs to the last bit, whatever the number of threads.
+TEST(TetSimulationTest, TheResultDoesNotDependOnTheNumberOfThreads) {
+  const TetMesh mesh = blocks({{{0, 0, 0}, {30, 30, 30}}, {{30, 0, 0}, {60, 30, 30}}}, 3.0);
+  std::vector<DrivenNode> driven = driven_by(nodes_at(mesh, 0, 0.0), 0);
+  for (const DrivenNode& d : driven_by(nodes_at(mesh, 0, 60.0), 1)) driven.push_back(d);
+  const auto run = [&](int threads) {
+    TetSimulation simulation(mesh, driven, {&far_handle(), &far_handle()}, {.threads = threads});
+    for (int frame = 1; frame <= 4; ++frame) {
+      Isometry3d left = Isometry3d::Identity();
+      left.translate(Vector3d(0, -1.5 * frame, 0));
+      Isometry3d right = Isometry3d::Identity();
+      right.translate(Vector3d(0, 1.5 * frame, 0));
+      simulation.step({left, right});
+    }
+    return Eigen::MatrixX3d(simulation.positions());
+  };
+  const Eigen::MatrixX3d one = run(1);
+  const Eigen::MatrixX3d two = run(2);
+  EXPECT_EQ(
+      std::memcmp(one.data(), two.data(), sizeof(double) * static_cast<std::size_t>(one.size())),
+      0);
 }
 
 TEST(TetSimulationTest, BadInputIsRefused) {

@@ -1,0 +1,141 @@
+// Node simulate_muscles (volumetric pathway): the toy leg's muscles driven by
+// the real walking trial keep their volume, stay out of the bones and out of
+// each other, with the energy pathway's outputs; the stored lattice is used
+// and a broken one is refused naming the file; the result does not depend on
+// the number of threads.
+
+#include "nodes/simulate_muscles.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+#include "core/directory_bundle.h"
+#include "core/errors.h"
+#include "core/mesh/io/pvd.h"
+#include "nodes/build_muscle_lattice.h"
+#include "tests/nodes/node_harness.h"
+#include "tests/nodes/toy_walk.h"
+#include "tests/support/test_data.h"
+
+namespace mmm::nodes {
+namespace {
+
+using test::toy_leg_and_walk;
+using test::ToyLegAndWalk;
+using workflow::PortType;
+
+nlohmann::json report_of(const std::map<std::string, workflow::ArtifactRef>& outputs) {
+  return nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
+}
+
+// Two vastus muscles touching along their length (overlapping 3 mm at rest:
+// the lattice gives the overlap to one of them), over 0.2 s of the walk.
+TEST(SimulateMusclesNodeTest, TouchingMusclesKeepVolumeStayApartAndOutOfTheBones) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.7, 3.0, true);
+  const auto lattice =
+      harness.run<BuildMuscleLattice>({{"atlas", toy.atlas}}, {{"spacing_mm", 2.0}});
+  const auto outputs = harness.run<SimulateMuscles>(
+      {{"atlas", toy.atlas}, {"motion", toy.motion}, {"lattice", lattice.at("lattice")}},
+      {{"animation_stride", std::int64_t{2}}, {"threads", std::int64_t{2}}});
+  const nlohmann::json report = report_of(outputs);
+  const int frames = report["frames"];
+  EXPECT_GE(frames, 10);
+  EXPECT_EQ(report["pathway"], "volumetric");
+  EXPECT_DOUBLE_EQ(report["model"]["spacing_mm"].get<double>(), 2.0);  // the stored lattice's
+  ASSERT_EQ(report["muscles"].size(), 2U);
+  EXPECT_LT(report["max_abs_volume_error_percent"].get<double>(), 1e-3);
+  EXPECT_LE(report["max_depth_mm"].get<double>(), 0.5);
+  EXPECT_TRUE(report["muscle_penetration_measured"].get<bool>());
+  EXPECT_LE(report["max_depth_in_other_muscles_mm"].get<double>(), 0.5);
+  EXPECT_EQ(report["max_inverted_elements"], 0);
+  // The vasti lie on the femur: elements reaching into it follow it.
+  EXPECT_GT(report["model"]["element_nodes_in_bones"].get<int>(), 0);
+  for (const nlohmann::json& muscle : report["muscles"]) {
+    EXPECT_GE(muscle["attachment_gap_mm"].get<double>(), 0.0) << muscle["muscle"];
+    EXPECT_LT(std::abs(muscle["lattice_change_percent"].get<double>()), 5.0) << muscle["muscle"];
+  }
+  // The energy pathway's outputs: one metrics row per muscle and frame.
+  const std::string metrics = mmm::test::read_text(outputs.at("metrics").path);
+  EXPECT_EQ(std::count(metrics.begin(), metrics.end(), '\n'), 1 + 2L * frames);
+  EXPECT_EQ(metrics.rfind("muscle,frame,time_s,volume_error_percent,max_depth_mm", 0), 0U);
+  const std::string lines = mmm::test::read_text(outputs.at("lines").path);
+  EXPECT_NE(lines.find("moment_arm_knee_angle_r_mm"), std::string::npos);
+  EXPECT_EQ(mmm::test::read_text(outputs.at("plot").path).rfind("<svg", 0), 0U);
+  const std::filesystem::path animation = harness.folder() / "animation";
+  unpack_directory(mmm::test::read_text(outputs.at("animation").path), animation, "animation");
+  const std::vector<mesh::PvdEntry> entries = mesh::read_pvd(animation / "wrapping.pvd");
+  long muscle_frames = 0;
+  for (const mesh::PvdEntry& entry : entries) {
+    if (entry.file.filename().string().rfind("vastus_b_r_", 0) == 0) ++muscle_frames;
+  }
+  EXPECT_EQ(muscle_frames, (frames + 1) / 2);
+}
+
+// Without a stored lattice the node builds one; one thread or two, the
+// muscles' surfaces are the same to the byte.
+TEST(SimulateMusclesNodeTest, TheSurfacesDoNotDependOnTheNumberOfThreads) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.58, -1.0, true);
+  const auto run = [&](std::int64_t threads, const std::string& folder) {
+    const auto outputs = harness.run<SimulateMuscles>(
+        {{"atlas", toy.atlas}, {"motion", toy.motion}},
+        {{"spacing_mm", 2.5}, {"threads", threads}, {"muscle_penetration", false}});
+    unpack_directory(mmm::test::read_text(outputs.at("animation").path), harness.folder() / folder,
+                     "animation");
+    return report_of(outputs);
+  };
+  const nlohmann::json one = run(1, "one");
+  const nlohmann::json two = run(2, "two");
+  EXPECT_FALSE(one["muscle_penetration_measured"].get<bool>());
+  EXPECT_DOUBLE_EQ(one["model"]["spacing_mm"].get<double>(), 2.5);
+  const std::string muscle = "vastus_r_0000.vtp";
+  const std::string a = mmm::test::read_text(harness.folder() / "one" / "wrapping" / muscle);
+  EXPECT_FALSE(a.empty());
+  EXPECT_EQ(a, mmm::test::read_text(harness.folder() / "two" / "wrapping" / muscle));
+}
+
+TEST(SimulateMusclesNodeTest, ABrokenLatticeIsRefusedNamingTheFile) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.55);
+  const auto lattice =
+      harness.run<BuildMuscleLattice>({{"atlas", toy.atlas}}, {{"spacing_mm", 3.0}});
+  const std::filesystem::path folder = harness.folder() / "broken";
+  unpack_directory(mmm::test::read_text(lattice.at("lattice").path), folder, "lattice");
+  const auto refuses = [&](const std::string& expected) {
+    try {
+      harness.run<SimulateMuscles>(
+          {{"atlas", toy.atlas},
+           {"motion", toy.motion},
+           {"lattice", harness.add(PortType::kFile, pack_directory(folder))}});
+      FAIL() << "a broken lattice was accepted";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  mmm::test::write_file(folder / "lattice.json", "{\"muscles\": [{\"muscle\": 3}]}");
+  refuses("lattice.json");
+  mmm::test::write_file(folder / "lattice.json",
+                        "{\"muscles\": [{\"muscle\": \"soleus_x\", \"segmented_mm3\": 1, "
+                        "\"kept_mm3\": 1}]}");
+  refuses("soleus_x");
+  mmm::test::write_file(folder / "muscles.lattice", "MMMLAT1\nshort");
+  refuses("muscles.lattice");
+}
+
+TEST(SimulateMusclesNodeTest, AMotionThatIsNotJsonIsRefusedNamingTheInput) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.55);
+  try {
+    harness.run<SimulateMuscles>(
+        {{"atlas", toy.atlas}, {"motion", harness.add(PortType::kBonePoses, "not json {")}});
+    FAIL() << "a motion that is not JSON was accepted";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("input 'motion'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace mmm::nodes
