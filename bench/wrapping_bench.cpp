@@ -386,6 +386,13 @@ nlohmann::json write_volumetric_table(std::ostringstream& out) {
         comma >> options.simulation.iterations;
   }
   options.anchor_elements_in_bones = std::getenv("MMM_BENCH_VOLUMETRIC_NO_ANCHORS") == nullptr;
+  // MMM_BENCH_VOLUMETRIC_WEIGHTS="shape,volume,contact,attachment reach mm".
+  if (const char* weights = std::getenv("MMM_BENCH_VOLUMETRIC_WEIGHTS"); weights != nullptr) {
+    char comma = 0;
+    std::istringstream(weights) >> options.simulation.shape_weight >> comma >>
+        options.simulation.volume_weight >> comma >> options.simulation.contact_weight >> comma >>
+        options.attachment_reach_mm;
+  }
   // MMM_BENCH_VOLUMETRIC_FRAMES: only the first n frames.
   motion::FusedMotion walk_frames = atlas_walk();
   if (const char* frames = std::getenv("MMM_BENCH_VOLUMETRIC_FRAMES"); frames != nullptr) {
@@ -407,8 +414,17 @@ nlohmann::json write_volumetric_table(std::ostringstream& out) {
       volumetric::simulate_muscles(models().atlas, atlas_dir(), walk_frames, options);
   const WalkSummary walk = summarise_walk(simulated.motion);
   std::vector<double> frame_ms;
-  for (const volumetric::FrameStats& frame : simulated.frames)
+  std::vector<double> local_ms;
+  std::vector<double> contact_ms;
+  std::vector<double> solve_ms;
+  std::vector<double> volume_ms;
+  for (const volumetric::FrameStats& frame : simulated.frames) {
     frame_ms.push_back(1000.0 * frame.seconds);
+    local_ms.push_back(1000.0 * frame.local_seconds);
+    contact_ms.push_back(1000.0 * frame.contact_seconds);
+    solve_ms.push_back(1000.0 * frame.solve_seconds);
+    volume_ms.push_back(1000.0 * frame.volume_seconds);
+  }
   const double whole =
       simulated.setup_seconds + simulated.simulation_seconds + simulated.lines_seconds;
   out << "\nwhole walk, volumetric pathway: " << simulated.motion.muscles.size() << " muscles x "
@@ -432,7 +448,9 @@ nlohmann::json write_volumetric_table(std::ostringstream& out) {
       << walk.max_bending_percent << " %\n"
       << "  time: setup " << std::setprecision(1) << simulated.setup_seconds << " s, simulation "
       << simulated.simulation_seconds << " s (median " << std::setprecision(0)
-      << wrapping::median(frame_ms) << " ms per frame), action lines " << std::setprecision(1)
+      << wrapping::median(frame_ms) << " ms per frame: local " << wrapping::median(local_ms)
+      << ", contacts " << wrapping::median(contact_ms) << ", solves " << wrapping::median(solve_ms)
+      << ", volumes " << wrapping::median(volume_ms) << "), action lines " << std::setprecision(1)
       << simulated.lines_seconds << " s, whole walk " << whole << " s; measurements "
       << simulated.measure_seconds << " s\n";
   out << "  " << std::left << std::setw(30) << "muscle" << std::setw(12) << "faces" << std::setw(14)

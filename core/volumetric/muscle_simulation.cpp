@@ -209,9 +209,24 @@ std::vector<DrivenNode> element_anchors(const TetMesh& elements, const wrapping:
       }
     }
   });
+  // An element reaching into two bones (tissue between the ischium and the
+  // femur, say) cannot follow both: its corners are left to the contacts.
+  std::vector<char> torn(bone_of.size(), 0);
+  for (Eigen::Index t = 0; t < elements.T.rows(); ++t) {
+    int first = -1;
+    bool two = false;
+    for (int c = 0; c < 4; ++c) {
+      const int bone = bone_of[static_cast<std::size_t>(elements.T(t, c))];
+      if (bone < 0) continue;
+      if (first >= 0 && bone != first) two = true;
+      first = bone;
+    }
+    if (!two) continue;
+    for (int c = 0; c < 4; ++c) torn[static_cast<std::size_t>(elements.T(t, c))] = 1;
+  }
   std::vector<DrivenNode> out;
   for (std::size_t i = 0; i < bone_of.size(); ++i) {
-    if (bone_of[i] >= 0) out.push_back({static_cast<int>(i), bone_of[i], true});
+    if (bone_of[i] >= 0 && torn[i] == 0) out.push_back({static_cast<int>(i), bone_of[i], true});
   }
   return out;
 }

@@ -41,7 +41,7 @@ struct MuscleSimulationOptions {
   // Element nodes inside a bone at rest follow it (an element reaching into a
   // bone moves with it); false: only the bone contacts hold the elements.
   bool anchor_elements_in_bones = true;
-  SimulationOptions simulation{.iterations = 5};
+  SimulationOptions simulation{.volume_weight = 10.0, .iterations = 5};
   int first_frame_intermediate_poses = 8;
   std::vector<std::string> muscles;  // empty: every muscle of the lattice (or atlas)
   bool muscle_penetration = true;    // measure the depth in the other muscles

@@ -24,7 +24,9 @@ using Eigen::Matrix3d;
 using Eigen::Vector3d;
 using Gradient = Eigen::Matrix<double, 4, 3>;
 
-constexpr int kVolumeSteps = 2;  // Newton steps on the muscles' volumes per round
+// Newton steps on the muscles' volumes: one per round, more after the last
+// (the volumes are then exact to ~1e-8).
+constexpr int kFinalVolumeSteps = 3;
 
 Matrix3d edges(const Eigen::MatrixX3d& x, const TetIndices& t, Eigen::Index i) {
   Matrix3d d;
@@ -176,6 +178,9 @@ struct TetSimulation::State {
   std::vector<std::vector<std::pair<int, double>>> blend;  // per node: (bone, weight)
   std::vector<Eigen::Isometry3d> last_poses;
   std::unique_ptr<VolumeRestorer> volumes;
+  // Per element node, its (element * 4 + corner) entries, CSR.
+  std::vector<int> incidence_start;
+  std::vector<int> incidence;
   double scale = 1.0;  // typical diagonal of the elements' part, for the weights
 };
 
@@ -327,14 +332,30 @@ TetSimulation::TetSimulation(EmbeddedModel model, std::vector<DrivenNode> driven
   }
   for (const State::Contact& c : s.contacts)
     add_point_term(weights, c.node, options.contact_weight * s.scale, triplets);
-  Eigen::SparseMatrix<double> a(n, n);
-  a.setFromTriplets(triplets.begin(), triplets.end());
-  s.solver.compute(a);
+  Eigen::SparseMatrix<double> system(n, n);
+  system.setFromTriplets(triplets.begin(), triplets.end());
+  s.solver.compute(system);
   if (s.solver.info() != Eigen::Success) {
     throw SolverError("simulation: the system could not be factored (a node in no tetrahedron?)");
   }
   s.x = elements.V;
   s.y = weights * s.x;
+  s.incidence_start.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (Eigen::Index t = 0; t < tets; ++t) {
+    for (int a = 0; a < 4; ++a) ++s.incidence_start[static_cast<std::size_t>(elements.T(t, a)) + 1];
+  }
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i)
+    s.incidence_start[i + 1] += s.incidence_start[i];
+  s.incidence.resize(static_cast<std::size_t>(tets) * 4);
+  {
+    std::vector<int> next(s.incidence_start.begin(), s.incidence_start.end() - 1);
+    for (Eigen::Index t = 0; t < tets; ++t) {
+      for (int a = 0; a < 4; ++a) {
+        s.incidence[static_cast<std::size_t>(next[static_cast<std::size_t>(elements.T(t, a))]++)] =
+            static_cast<int>(t) * 4 + a;
+      }
+    }
+  }
   // Element nodes that carry an attachment: the seeds of the warm start's
   // blend, and held by the volume steps.
   std::vector<DrivenNode> seeds;
@@ -475,14 +496,18 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
     parallel_for(s.contacts.size(), o.threads,
                  [&](std::size_t c) { contact_target[c] = outside_of(c); });
     stats.contact_seconds += lap(since);
+    // sum_t V_t G_t P_t^T: row a of G_t P^T goes to corner a; each node
+    // sums its elements' rows in a fixed order (the same on any thread).
     Eigen::MatrixX3d rhs = fixed_rhs;
-    for (Eigen::Index t = 0; t < tets; ++t) {
-      // sum_t V_t G_t P_t^T: row a of G_t P^T goes to corner a.
-      const Eigen::Matrix<double, 4, 3> part = s.rest_volume[t] *
-                                               s.gradient[static_cast<std::size_t>(t)] *
-                                               target_f[static_cast<std::size_t>(t)].transpose();
-      for (int a = 0; a < 4; ++a) rhs.row(elements.T(t, a)) += part.row(a);
-    }
+    parallel_for(static_cast<std::size_t>(n), o.threads, [&](std::size_t i) {
+      for (int k = s.incidence_start[i]; k < s.incidence_start[i + 1]; ++k) {
+        const auto t = static_cast<std::size_t>(s.incidence[static_cast<std::size_t>(k)] / 4);
+        const int corner = s.incidence[static_cast<std::size_t>(k)] % 4;
+        rhs.row(static_cast<Eigen::Index>(i)) +=
+            s.rest_volume[static_cast<Eigen::Index>(t)] *
+            (s.gradient[t].row(corner) * target_f[t].transpose());
+      }
+    });
     for (std::size_t c = 0; c < s.contacts.size(); ++c) {
       add_point_rhs(weights, s.contacts[c].node, o.contact_weight * s.scale, contact_target[c],
                     rhs);
@@ -490,7 +515,7 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
     s.x = s.solver.solve(rhs);
     s.y = weights * s.x;
     stats.solve_seconds += lap(since);
-    s.volumes->restore(s.x, s.y, kVolumeSteps, o.threads);
+    s.volumes->restore(s.x, s.y, iteration + 1 == o.iterations ? kFinalVolumeSteps : 1, o.threads);
     stats.volume_seconds += lap(since);
   }
   std::vector<double> depth(s.contacts.size(), 0.0);

@@ -58,7 +58,7 @@ struct SimulationOptions {
   double inertia_weight = 1.0e-3;  // against the tetrahedra's
   double contact_weight = 10.0;    // against the tetrahedra's, per checked node
   int iterations = 10;             // local-global rounds per frame
-  int rotation_iterations = 4;     // polar-decomposition steps per element and round
+  int rotation_iterations = 2;     // polar-decomposition steps per element and round
   double bone_clearance_mm = 0.1;
   double contact_reach_mm = 15.0;  // nodes this close to a bone at rest are checked
   int threads = 1;
