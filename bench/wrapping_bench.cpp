@@ -1,9 +1,11 @@
-// Muscle wrapping, energy pathway. (1) The whole walk: subject01's trial
+// Muscle wrapping, both pathways. (1) The whole walk: subject01's trial
 // (0.5-2.5 s, 121 frames) fitted to its OpenSim model, retargeted to the
 // default atlas, and every atlas muscle wrapped at every frame (volume held,
 // out of the bones): per-muscle volume error, penetration, bending change and
 // time beside the reference implementation's figures (VPHOP D10.2, section
-// 3.4.2); plot in $MMM_BENCH_OUT_DIR/wrapping_metrics.svg. (2) The action
+// 3.4.2); plot in $MMM_BENCH_OUT_DIR/wrapping_metrics.svg; then the same
+// walk with the volumetric pathway (core/volumetric/muscle_simulation.h,
+// MMM_BENCH_WRAPPING_PATHWAYS picks either). (2) The action
 // lines' hip-flexion moment arms on the default atlas (gait2392's paths
 // carried onto the Visible Human Female's bones) beside the gait2392
 // model's own, over hip flexion -20..60 degrees. (3) Google Benchmark: a
@@ -386,6 +388,8 @@ nlohmann::json write_volumetric_table(std::ostringstream& out) {
         comma >> options.simulation.iterations;
   }
   options.anchor_elements_in_bones = std::getenv("MMM_BENCH_VOLUMETRIC_NO_ANCHORS") == nullptr;
+  if (const char* clearance = std::getenv("MMM_BENCH_VOLUMETRIC_JOINT_CLEARANCE"))
+    options.anchor_joint_clearance_mm = std::stod(clearance);
   // MMM_BENCH_VOLUMETRIC_WEIGHTS="shape,volume,contact,attachment reach mm".
   if (const char* weights = std::getenv("MMM_BENCH_VOLUMETRIC_WEIGHTS"); weights != nullptr) {
     char comma = 0;

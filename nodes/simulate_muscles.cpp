@@ -85,6 +85,7 @@ volumetric::MuscleSimulationOptions options_from(const workflow::NodeContext& co
   options.coarsening = static_cast<int>(context.integer("coarsening"));
   options.simulation.iterations = static_cast<int>(context.integer("rounds"));
   options.attachment_reach_mm = context.number("attachment_reach_mm");
+  options.anchor_joint_clearance_mm = context.number("joint_clearance_mm");
   options.first_frame_intermediate_poses =
       static_cast<int>(context.integer("first_frame_intermediate_poses"));
   options.muscles = split_names(context.text("muscles"));
@@ -177,6 +178,7 @@ nlohmann::json report_of(const volumetric::MuscleSimulation& simulated,
         {"coarsening", options.coarsening},
         {"rounds", options.simulation.iterations},
         {"attachment_reach_mm", options.attachment_reach_mm},
+        {"joint_clearance_mm", options.anchor_joint_clearance_mm},
         {"first_frame_intermediate_poses", options.first_frame_intermediate_poses},
         {"path_method",
          options.routing.method == wrapping::PathMethod::kGlobal ? "global" : "obstacle_set"}}}};
@@ -214,6 +216,11 @@ workflow::NodeSpec SimulateMuscles::spec() {
                      "A muscle's surface nodes this close to one of its attachment areas follow "
                      "that bone",
                      {.min = 0.1, .max = 50.0}, "mm")
+      .param<double>("joint_clearance_mm", d.anchor_joint_clearance_mm,
+                     "Elements reaching into a bone follow it, except within this distance of "
+                     "a bone that moves otherwise (a joint), where the tissue is left to slide "
+                     "(0: everywhere)",
+                     {.min = 0.0, .max = 50.0}, "mm")
       .param<std::int64_t>("first_frame_intermediate_poses", d.first_frame_intermediate_poses,
                            "Steps between the rest pose and the first frame",
                            {.min = 0, .max = 100})

@@ -197,7 +197,7 @@ double move_out_of_bones(EmbeddedModel& model, const std::vector<int>& boundary_
 // a bone (across a thin wing, say) moves with the bone instead of being
 // pushed out of it on both sides.
 std::vector<DrivenNode> element_anchors(const TetMesh& elements, const wrapping::PosedBones& bones,
-                                        double reach, int threads) {
+                                        double reach, double joint_clearance, int threads) {
   std::vector<int> bone_of(static_cast<std::size_t>(elements.V.rows()), -1);
   parallel_for(bone_of.size(), threads, [&](std::size_t i) {
     const Eigen::Vector3d p = elements.V.row(static_cast<Eigen::Index>(i)).transpose();
@@ -205,6 +205,19 @@ std::vector<DrivenNode> element_anchors(const TetMesh& elements, const wrapping:
       const mesh::SignedDistance& sdf = *bones.surfaces[b].surface;
       if (sdf.tree().closest_point_within(p, reach * reach) && sdf.winding().is_inside(p)) {
         bone_of[i] = static_cast<int>(b);
+        break;
+      }
+    }
+    // Near a joint the tissue slides over both bones: not anchored.
+    if (bone_of[i] < 0 || !(joint_clearance > 0)) return;
+    for (std::size_t b = 0; b < bones.surfaces.size(); ++b) {
+      if (static_cast<int>(b) == bone_of[i] ||
+          bones.bodies[b] == bones.bodies[static_cast<std::size_t>(bone_of[i])]) {
+        continue;
+      }
+      if (bones.surfaces[b].surface->tree().closest_point_within(
+              p, joint_clearance * joint_clearance)) {
+        bone_of[i] = -1;
         return;
       }
     }
@@ -332,7 +345,8 @@ MuscleSimulation simulate_muscles(const atlas::Atlas& atlas, const std::filesyst
       !options.anchor_elements_in_bones
           ? std::vector<DrivenNode>{}
           : element_anchors(model.elements, bones,
-                            labels.spacing_mm * options.coarsening * std::sqrt(3.0), threads);
+                            labels.spacing_mm * options.coarsening * std::sqrt(3.0),
+                            options.anchor_joint_clearance_mm, threads);
   result.anchored_element_nodes = static_cast<int>(anchors.size());
   driven.insert(driven.end(), anchors.begin(), anchors.end());
   result.element_nodes = model.elements.V.rows();

@@ -5,9 +5,13 @@
 // (wrapping::MuscleWrapping), so that the metrics, action lines, animation
 // and report are written by the same code.
 //
-// Per muscle, its surface is the boundary of its fine tetrahedra; the
-// boundary nodes within attachment_reach_mm of one of its attachment areas
-// (atlas, on the bone's full mesh) follow that bone rigidly; an area farther
+// Per muscle, its surface is the boundary of its fine tetrahedra. At rest,
+// surface nodes in a bone (the lattice's staircase) are moved out onto it.
+// Element nodes inside a bone follow it (an element reaching into a bone
+// moves with it), except within anchor_joint_clearance_mm of a bone that
+// moves otherwise (a joint) or where an element reaches into two bones. A
+// muscle's boundary nodes within attachment_reach_mm of one of its
+// attachment areas (atlas, on the bone's full mesh) follow that bone rigidly; an area farther
 // from the muscle is reached through a tendon the lattice does not hold, and
 // is left out (the muscle's end follows the tissue around it). Per frame:
 // the bones' poses from the motion, one simulation step (warm-started from
@@ -41,7 +45,11 @@ struct MuscleSimulationOptions {
   // Element nodes inside a bone at rest follow it (an element reaching into a
   // bone moves with it); false: only the bone contacts hold the elements.
   bool anchor_elements_in_bones = true;
-  SimulationOptions simulation{.volume_weight = 10.0, .iterations = 5};
+  // Not those within this distance of a bone that moves otherwise (a
+  // joint's other side), where tissue slides over both: the contacts hold
+  // them. 0: every one.
+  double anchor_joint_clearance_mm = 10.0;
+  SimulationOptions simulation{.volume_weight = 10.0, .iterations = 2};
   int first_frame_intermediate_poses = 8;
   std::vector<std::string> muscles;  // empty: every muscle of the lattice (or atlas)
   bool muscle_penetration = true;    // measure the depth in the other muscles
