@@ -483,7 +483,7 @@ MuscleSimulation simulate_muscles(const atlas::Atlas& atlas, const std::filesyst
       metrics.converged = stats.inverted == 0;
       metrics.seconds = stats.seconds / static_cast<double>(muscles.size());
       w.frames.push_back(metrics);
-      w.positions.push_back(positions[m].cast<float>());
+      w.positions.emplace_back(positions[m].cast<float>());
     });
     result.measure_seconds += seconds_since(since);
     if (options.muscle_penetration) out.muscle_penetration_seconds = result.measure_seconds;

@@ -450,7 +450,7 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
   const auto outside_of = [&](std::size_t c) -> Vector3d {
     State::Contact& k = s.contacts[c];
     const auto b = static_cast<std::size_t>(k.bone);
-    const Vector3d here = s.y.row(k.node).transpose();
+    Vector3d here = s.y.row(k.node).transpose();
     const Vector3d p = inverse[b] * here;
     if (k.clear_within > 0 && (p - k.last_point).squaredNorm() < k.clear_within * k.clear_within) {
       return here;

@@ -115,11 +115,11 @@ TEST(SimulateMusclesNodeTest, ABrokenLatticeIsRefusedNamingTheFile) {
       EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
     }
   };
-  mmm::test::write_file(folder / "lattice.json", "{\"muscles\": [{\"muscle\": 3}]}");
+  mmm::test::write_file(folder / "lattice.json", R"({"muscles": [{"muscle": 3}]})");
   refuses("lattice.json");
-  mmm::test::write_file(folder / "lattice.json",
-                        "{\"muscles\": [{\"muscle\": \"soleus_x\", \"segmented_mm3\": 1, "
-                        "\"kept_mm3\": 1}]}");
+  mmm::test::write_file(
+      folder / "lattice.json",
+      R"({"muscles": [{"muscle": "soleus_x", "segmented_mm3": 1, "kept_mm3": 1}]})");
   refuses("soleus_x");
   mmm::test::write_file(folder / "muscles.lattice", "MMMLAT1\nshort");
   refuses("muscles.lattice");

@@ -149,7 +149,7 @@ TEST(TetSimulationTest, ARigidMotionOfEverythingIsReproducedExactly) {
   std::vector<IndexedMesh> surfaces = {mesh::make_box({0, 0, 0}, {24, 24, 24}),
                                        mesh::make_box({24, 0, 0}, {48, 24, 24})};
   const LabelledLattice lattice = build_labelled_lattice(
-      {{"a", &surfaces[0]}, {"b", &surfaces[1]}}, {}, {.spacing_mm = 1.5, .max_regrowth_mm = 0});
+      {{"a", surfaces.data()}, {"b", &surfaces[1]}}, {}, {.spacing_mm = 1.5, .max_regrowth_mm = 0});
   EmbeddedModel model = embed_in_coarse_lattice(lattice, 2);
   std::vector<DrivenNode> driven;
   for (const double x : {0.0, 48.0}) {
