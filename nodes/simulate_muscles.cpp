@@ -252,21 +252,7 @@ void SimulateMuscles::run(workflow::NodeContext& context) {
   const std::filesystem::path atlas_dir = context.scratch_dir() / "atlas";
   unpack_directory(context.input_bytes("atlas"), atlas_dir, "input 'atlas'");
   const atlas::Atlas atlas = atlas::read_atlas(atlas_dir);
-  const auto motion_bytes = context.input_bytes("motion");
-  nlohmann::json motion_json;
-  try {
-    motion_json = parse_json(motion_bytes);
-  } catch (const nlohmann::json::exception& e) {
-    throw InvalidInputError("simulate_muscles: input 'motion' is not JSON (" +
-                            std::string(e.what()) + "); hint: connect fuse_motion's 'motion'");
-  }
-  const motion::FusedMotion fused =
-      motion::motion_from_json(motion_json, "simulate_muscles: input 'motion'");
-  if (motion_json.value("model_kind", "") != "atlas") {
-    throw InvalidInputError(
-        "simulate_muscles: input 'motion' drives an OpenSim model, not an atlas; hint: give "
-        "fuse_motion the atlas input (and the model to retarget from)");
-  }
+  const motion::FusedMotion fused = atlas_motion_input(context, "simulate_muscles");
   std::optional<volumetric::LabelledLattice> lattice;
   if (context.has_input("lattice")) {
     const std::filesystem::path folder = context.scratch_dir() / "lattice";
@@ -290,15 +276,8 @@ void SimulateMuscles::run(workflow::NodeContext& context) {
                " mm, in other muscles " +
                fixed(report["max_depth_in_other_muscles_mm"].get<double>(), 2) + " mm");
   context.progress(2, 3, "writing the outputs");
-  context.set_output("metrics", metrics_csv(simulated.motion));
-  context.set_output("lines", lines_csv(simulated.motion));
-  context.set_output("plot",
-                     wrapping::wrapping_metrics_svg(
-                         simulated.motion, "Muscle wrapping over the trial (volumetric pathway)"));
-  context.set_output(
-      "animation",
-      animation_bundle(context, simulated.motion, atlas, atlas_dir, context.text("bone_level"),
-                       static_cast<int>(context.integer("animation_stride"))));
+  set_wrapping_outputs(context, simulated.motion, atlas, atlas_dir,
+                       "Muscle wrapping over the trial (volumetric pathway)");
   report["node_seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   context.set_output("report", report.dump(2));

@@ -245,22 +245,7 @@ void WrapMuscles::run(workflow::NodeContext& context) {
   const std::filesystem::path atlas_dir = context.scratch_dir() / "atlas";
   unpack_directory(context.input_bytes("atlas"), atlas_dir, "input 'atlas'");
   const atlas::Atlas atlas = atlas::read_atlas(atlas_dir);
-  const auto motion_bytes = context.input_bytes("motion");
-  const std::string motion_text(motion_bytes.begin(), motion_bytes.end());
-  nlohmann::json motion_json;
-  try {
-    motion_json = parse_json(motion_text);
-  } catch (const nlohmann::json::exception& e) {
-    throw InvalidInputError("wrap_muscles: input 'motion' is not JSON (" + std::string(e.what()) +
-                            "); hint: connect fuse_motion's 'motion' output");
-  }
-  const motion::FusedMotion fused =
-      motion::motion_from_json(motion_json, "wrap_muscles: input 'motion'");
-  if (motion_json.value("model_kind", "") != "atlas") {
-    throw InvalidInputError(
-        "wrap_muscles: input 'motion' drives an OpenSim model, not an atlas; hint: give "
-        "fuse_motion the atlas input (and the model to retarget from)");
-  }
+  const motion::FusedMotion fused = atlas_motion_input(context, "wrap_muscles");
   wrapping::MuscleWrappingOptions options = wrapping_options_from(context);
   if (context.has_input("hulls")) {
     const std::filesystem::path hulls_dir = context.scratch_dir() / "hulls";
@@ -287,13 +272,8 @@ void WrapMuscles::run(workflow::NodeContext& context) {
                fixed(report["max_abs_volume_error_percent"].get<double>(), 6) + " %, max depth " +
                fixed(report["max_depth_mm"].get<double>(), 2) + " mm");
   context.progress(2, 3, "writing the outputs");
-  context.set_output("metrics", metrics_csv(wrapped));
-  context.set_output("lines", lines_csv(wrapped));
-  context.set_output("plot", wrapping::wrapping_metrics_svg(
-                                 wrapped, "Muscle wrapping over the trial (energy pathway)"));
-  context.set_output(
-      "animation", animation_bundle(context, wrapped, atlas, atlas_dir, context.text("bone_level"),
-                                    static_cast<int>(context.integer("animation_stride"))));
+  set_wrapping_outputs(context, wrapped, atlas, atlas_dir,
+                       "Muscle wrapping over the trial (energy pathway)");
   report["node_seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   context.set_output("report", report.dump(2));

@@ -6,9 +6,13 @@
 #include <vector>
 
 #include "core/atlas/structure_carriage.h"
+#include "core/bounded_json.h"
 #include "core/directory_bundle.h"
+#include "core/errors.h"
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/io/vtp_series.h"
+#include "core/motion/motion_io.h"
+#include "core/wrapping/wrapping_summary.h"
 #include "nodes/number_text.h"
 
 namespace mmm::nodes {
@@ -126,6 +130,35 @@ std::string animation_bundle(const workflow::NodeContext& context,
   }
   series.finish();
   return pack_directory(folder);
+}
+
+motion::FusedMotion atlas_motion_input(const workflow::NodeContext& context,
+                                       const std::string& node) {
+  nlohmann::json json;
+  try {
+    json = parse_json(context.input_bytes("motion"));
+  } catch (const nlohmann::json::exception& e) {
+    throw InvalidInputError(node + ": input 'motion' is not JSON (" + std::string(e.what()) +
+                            "); hint: connect fuse_motion's 'motion' output");
+  }
+  motion::FusedMotion fused = motion::motion_from_json(json, node + ": input 'motion'");
+  if (json.value("model_kind", "") != "atlas") {
+    throw InvalidInputError(node +
+                            ": input 'motion' drives an OpenSim model, not an atlas; hint: give "
+                            "fuse_motion the atlas input (and the model to retarget from)");
+  }
+  return fused;
+}
+
+void set_wrapping_outputs(workflow::NodeContext& context, const wrapping::MuscleWrapping& wrapped,
+                          const atlas::Atlas& atlas, const std::filesystem::path& atlas_dir,
+                          const std::string& plot_title) {
+  context.set_output("metrics", metrics_csv(wrapped));
+  context.set_output("lines", lines_csv(wrapped));
+  context.set_output("plot", wrapping::wrapping_metrics_svg(wrapped, plot_title));
+  context.set_output(
+      "animation", animation_bundle(context, wrapped, atlas, atlas_dir, context.text("bone_level"),
+                                    static_cast<int>(context.integer("animation_stride"))));
 }
 
 }  // namespace mmm::nodes

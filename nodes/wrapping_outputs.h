@@ -1,16 +1,30 @@
 #pragma once
-// The outputs both wrapping pathways write (wrap_muscles, simulate_muscles),
-// from their common result (wrapping::MuscleWrapping): the metrics and
-// action-line CSVs and the ParaView animation.
+// What both wrapping pathways (wrap_muscles, simulate_muscles) share: the
+// fused motion they read, and the outputs they write from their common
+// result (wrapping::MuscleWrapping): the metrics and action-line CSVs, the
+// plot and the ParaView animation.
 
 #include <filesystem>
 #include <string>
 
 #include "core/atlas/atlas.h"
+#include "core/motion/motion_fusion.h"
 #include "core/wrapping/muscle_wrapping.h"
 #include "workflow/node_context.h"
 
 namespace mmm::nodes {
+
+// The input 'motion': fuse_motion's motion of an atlas. Throws
+// InvalidInputError (naming `node` and the input, with a hint) when it is not
+// JSON, not a motion, or drives an OpenSim model instead of an atlas.
+motion::FusedMotion atlas_motion_input(const workflow::NodeContext& context,
+                                       const std::string& node);
+
+// Sets the outputs 'metrics', 'lines', 'plot' (titled `plot_title`) and
+// 'animation' (parameters 'bone_level' and 'animation_stride').
+void set_wrapping_outputs(workflow::NodeContext& context, const wrapping::MuscleWrapping& wrapped,
+                          const atlas::Atlas& atlas, const std::filesystem::path& atlas_dir,
+                          const std::string& plot_title);
 
 // One row per muscle and frame: volume error, bone and muscle penetration,
 // contacts, smoothness, time.

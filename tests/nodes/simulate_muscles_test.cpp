@@ -57,21 +57,8 @@ TEST(SimulateMusclesNodeTest, TouchingMusclesKeepVolumeStayApartAndOutOfTheBones
     EXPECT_GE(muscle["attachment_gap_mm"].get<double>(), 0.0) << muscle["muscle"];
     EXPECT_LT(std::abs(muscle["lattice_change_percent"].get<double>()), 5.0) << muscle["muscle"];
   }
-  // The energy pathway's outputs: one metrics row per muscle and frame.
-  const std::string metrics = mmm::test::read_text(outputs.at("metrics").path);
-  EXPECT_EQ(std::count(metrics.begin(), metrics.end(), '\n'), 1 + 2L * frames);
-  EXPECT_EQ(metrics.rfind("muscle,frame,time_s,volume_error_percent,max_depth_mm", 0), 0U);
-  const std::string lines = mmm::test::read_text(outputs.at("lines").path);
-  EXPECT_NE(lines.find("moment_arm_knee_angle_r_mm"), std::string::npos);
-  EXPECT_EQ(mmm::test::read_text(outputs.at("plot").path).rfind("<svg", 0), 0U);
-  const std::filesystem::path animation = harness.folder() / "animation";
-  unpack_directory(mmm::test::read_text(outputs.at("animation").path), animation, "animation");
-  const std::vector<mesh::PvdEntry> entries = mesh::read_pvd(animation / "wrapping.pvd");
-  long muscle_frames = 0;
-  for (const mesh::PvdEntry& entry : entries) {
-    if (entry.file.filename().string().rfind("vastus_b_r_", 0) == 0) ++muscle_frames;
-  }
-  EXPECT_EQ(muscle_frames, (frames + 1) / 2);
+  // The energy pathway's outputs.
+  test::expect_wrapping_outputs(harness, outputs, frames, 2, "vastus_b_r", 2);
 }
 
 // Without a stored lattice the node builds one; one thread or two, the

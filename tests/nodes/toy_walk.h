@@ -3,14 +3,19 @@
 // added, written into a node harness, and its motion from fuse_motion over
 // the real trial (0.5 s to end_time), for the wrapping nodes' tests.
 
+#include <gtest/gtest.h>
 #include <Eigen/Core>
+
 #include <algorithm>
+#include <filesystem>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/atlas/atlas_io.h"
 #include "core/directory_bundle.h"
+#include "core/mesh/io/pvd.h"
 #include "nodes/fuse_motion.h"
 #include "tests/support/test_data.h"
 
@@ -97,6 +102,32 @@ inline ToyLegAndWalk toy_leg_and_walk(
       {{"start_time", 0.5}, {"end_time", end_time}});
   result.motion = fused.at("motion");
   return result;
+}
+
+// The outputs both wrapping nodes write: one metrics row per muscle and
+// frame, the action lines with the knee's moment arm, an SVG plot, and every
+// `stride`-th frame of `muscle`, the femur and the lines in the ParaView
+// animation.
+inline void expect_wrapping_outputs(NodeHarness& harness,
+                                    const std::map<std::string, workflow::ArtifactRef>& outputs,
+                                    int frames, long muscles, const std::string& muscle,
+                                    int stride) {
+  const std::string metrics = mmm::test::read_text(outputs.at("metrics").path);
+  EXPECT_EQ(std::count(metrics.begin(), metrics.end(), '\n'), 1 + frames * muscles);
+  EXPECT_EQ(metrics.rfind("muscle,frame,time_s,volume_error_percent,max_depth_mm", 0), 0U);
+  const std::string lines = mmm::test::read_text(outputs.at("lines").path);
+  EXPECT_NE(lines.find("moment_arm_knee_angle_r_mm"), std::string::npos);
+  EXPECT_EQ(mmm::test::read_text(outputs.at("plot").path).rfind("<svg", 0), 0U);
+  const std::filesystem::path animation = harness.folder() / "animation";
+  std::filesystem::remove_all(animation);
+  unpack_directory(mmm::test::read_text(outputs.at("animation").path), animation, "animation");
+  long muscle_frames = 0;
+  for (const mesh::PvdEntry& entry : mesh::read_pvd(animation / "wrapping.pvd")) {
+    if (entry.file.filename().string().rfind(muscle + "_", 0) == 0) ++muscle_frames;
+  }
+  EXPECT_EQ(muscle_frames, (frames + stride - 1) / stride);
+  EXPECT_TRUE(std::filesystem::exists(animation / "wrapping" / "action_lines_0000.vtp"));
+  EXPECT_TRUE(std::filesystem::exists(animation / "wrapping" / "femur_r_0000.vtp"));
 }
 
 }  // namespace mmm::nodes::test

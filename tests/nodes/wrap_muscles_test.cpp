@@ -46,26 +46,9 @@ TEST(WrapMusclesNodeTest, WrapsTheToyLegsMuscleOverARetargetedWalk) {
   EXPECT_LE(report["max_depth_mm"].get<double>(), 0.1 + 1e-9);  // the contact tolerance
   EXPECT_EQ(report["unconverged_muscle_frames"], 0);
   ASSERT_EQ(report["muscles"].size(), leg.atlas.muscles.size());
-  // One metrics row per muscle and frame, one line row per line and frame.
-  const std::string metrics = mmm::test::read_text(outputs.at("metrics").path);
-  EXPECT_EQ(std::count(metrics.begin(), metrics.end(), '\n'),
-            1 + frames * static_cast<long>(leg.atlas.muscles.size()));
-  EXPECT_EQ(metrics.rfind("muscle,frame,time_s,volume_error_percent,max_depth_mm", 0), 0U);
-  const std::string lines = mmm::test::read_text(outputs.at("lines").path);
-  EXPECT_NE(lines.find("moment_arm_knee_angle_r_mm"), std::string::npos);
-  EXPECT_EQ(mmm::test::read_text(outputs.at("plot").path).rfind("<svg", 0), 0U);
-  // ParaView: every other frame of the muscle, the bones and the lines.
-  const std::filesystem::path animation = harness.folder() / "animation";
-  unpack_directory(mmm::test::read_text(outputs.at("animation").path), animation, "animation");
-  const std::vector<mesh::PvdEntry> entries = mesh::read_pvd(animation / "wrapping.pvd");
-  const std::string muscle = leg.atlas.muscles.front().name;
-  long muscle_frames = 0;
-  for (const mesh::PvdEntry& entry : entries) {
-    if (entry.file.filename().string().rfind(muscle + "_", 0) == 0) ++muscle_frames;
-  }
-  EXPECT_EQ(muscle_frames, (frames + 1) / 2);
-  EXPECT_TRUE(std::filesystem::exists(animation / "wrapping" / "action_lines_0000.vtp"));
-  EXPECT_TRUE(std::filesystem::exists(animation / "wrapping" / "femur_r_0000.vtp"));
+  test::expect_wrapping_outputs(harness, outputs, frames,
+                                static_cast<long>(leg.atlas.muscles.size()),
+                                leg.atlas.muscles.front().name, 2);
 }
 
 // decompose_fibres after wrap_muscles: fibres at every frame of the
