@@ -192,58 +192,58 @@ workflow::NodeSpec SimulateMuscles::spec() {
   using workflow::port::File;
   using workflow::port::Report;
   const volumetric::MuscleSimulationOptions d;
-  return workflow::NodeSpec{
-      "simulate_muscles", 1,
-      "Muscle wrapping over a fused motion (volumetric pathway): every muscle in one conforming "
-      "tetrahedral model, touching muscles sharing their interface, moved by the bones frame by "
-      "frame (projective dynamics), each muscle's volume restored exactly, attachments following "
-      "their bones, surfaces kept out of the bones"}
-      .input<Atlas>("atlas", "The (scaled) atlas the motion drives")
-      .input<BonePoses>("motion", "Fused motion of this atlas (fuse_motion with the atlas input)")
-      .optional_input<File>("lattice",
-                            "The model at rest (build_muscle_lattice on the same atlas); without "
-                            "it the lattice is built here")
-      .param<double>("spacing_mm", d.lattice.spacing_mm,
-                     "Without a lattice input: the lattice's cell edge", {.min = 0.5, .max = 20.0},
-                     "mm")
-      .param<std::int64_t>("coarsening", d.coarsening,
-                           "Simulated elements are this many lattice cells across; the surfaces "
-                           "keep the lattice's detail (1: every cell simulated)",
-                           {.min = 1, .max = 8})
-      .param<std::int64_t>("rounds", d.simulation.iterations, "Local-global rounds per frame",
-                           {.min = 1, .max = 100})
-      .param<double>("attachment_reach_mm", d.attachment_reach_mm,
-                     "A muscle's surface nodes this close to one of its attachment areas follow "
-                     "that bone",
-                     {.min = 0.1, .max = 50.0}, "mm")
-      .param<double>("joint_clearance_mm", d.anchor_joint_clearance_mm,
-                     "Elements reaching into a bone follow it, except within this distance of "
-                     "a bone that moves otherwise (a joint), where the tissue is left to slide "
-                     "(0: everywhere)",
-                     {.min = 0.0, .max = 50.0}, "mm")
-      .param<std::int64_t>("first_frame_intermediate_poses", d.first_frame_intermediate_poses,
-                           "Steps between the rest pose and the first frame",
-                           {.min = 0, .max = 100})
-      .param<std::string>("muscles", "",
-                          "Comma-separated muscle names; empty: every muscle of the lattice (or "
-                          "the atlas)")
-      .param<bool>("muscle_penetration", d.muscle_penetration,
-                   "Measure how far the muscles' surfaces run into each other (a metric)")
-      .param_enum("path_method", "obstacle_set", {"obstacle_set", "global"},
-                  "Action-line paths: over the atlas's fitted obstacles, or the shortest path "
-                  "keeping clear of the bone meshes (Ceres)")
-      .param<std::int64_t>("threads", 0, "Worker threads; 0: the machine's", {.min = 0, .max = 64})
-      .param<std::int64_t>("animation_stride", 5, "The animation holds every n-th frame",
-                           {.min = 1, .max = 1000})
-      .param<std::string>("bone_level", "lod2",
-                          "Atlas mesh level of the bones drawn in the animation")
-      .output<File>("animation",
-                    "Folder bundle of a ParaView animation (wrapping.pvd + .vtp per frame)")
-      .output<File>("metrics",
-                    "CSV per muscle and frame: volume error, penetration, smoothness, time")
-      .output<File>("lines", "CSV per action line and frame: length and moment arms")
-      .output<File>("plot", "SVG: volume error, penetration depth and time per frame")
-      .output<Report>("report", "Per-muscle summaries, the model, timings, targets");
+  workflow::NodeSpec spec =
+      workflow::NodeSpec{"simulate_muscles", 1,
+                         "Muscle wrapping over a fused motion (volumetric pathway): every muscle "
+                         "in one conforming "
+                         "tetrahedral model, touching muscles sharing their interface, moved by "
+                         "the bones frame by "
+                         "frame (projective dynamics), each muscle's volume restored exactly, "
+                         "attachments following "
+                         "their bones, surfaces kept out of the bones"}
+          .input<Atlas>("atlas", "The (scaled) atlas the motion drives")
+          .input<BonePoses>("motion",
+                            "Fused motion of this atlas (fuse_motion with the atlas input)")
+          .optional_input<File>(
+              "lattice",
+              "The model at rest (build_muscle_lattice on the same atlas); without "
+              "it the lattice is built here")
+          .param<double>("spacing_mm", d.lattice.spacing_mm,
+                         "Without a lattice input: the lattice's cell edge",
+                         {.min = 0.5, .max = 20.0}, "mm")
+          .param<std::int64_t>(
+              "coarsening", d.coarsening,
+              "Simulated elements are this many lattice cells across; the surfaces "
+              "keep the lattice's detail (1: every cell simulated)",
+              {.min = 1, .max = 8})
+          .param<std::int64_t>("rounds", d.simulation.iterations, "Local-global rounds per frame",
+                               {.min = 1, .max = 100})
+          .param<double>(
+              "attachment_reach_mm", d.attachment_reach_mm,
+              "A muscle's surface nodes this close to one of its attachment areas follow "
+              "that bone",
+              {.min = 0.1, .max = 50.0}, "mm")
+          .param<double>("joint_clearance_mm", d.anchor_joint_clearance_mm,
+                         "Elements reaching into a bone follow it, except within this distance of "
+                         "a bone that moves otherwise (a joint), where the tissue is left to slide "
+                         "(0: everywhere)",
+                         {.min = 0.0, .max = 50.0}, "mm")
+          .param<std::int64_t>("first_frame_intermediate_poses", d.first_frame_intermediate_poses,
+                               "Steps between the rest pose and the first frame",
+                               {.min = 0, .max = 100})
+          .param<std::string>(
+              "muscles", "",
+              "Comma-separated muscle names; empty: every muscle of the lattice (or "
+              "the atlas)")
+          .param<bool>("muscle_penetration", d.muscle_penetration,
+                       "Measure how far the muscles' surfaces run into each other (a metric)")
+          .param_enum("path_method", "obstacle_set", {"obstacle_set", "global"},
+                      "Action-line paths: over the atlas's fitted obstacles, or the shortest path "
+                      "keeping clear of the bone meshes (Ceres)")
+          .param<std::int64_t>("threads", 0, "Worker threads; 0: the machine's",
+                               {.min = 0, .max = 64});
+  add_wrapping_outputs(spec);
+  return spec.output<Report>("report", "Per-muscle summaries, the model, timings, targets");
 }
 
 void SimulateMuscles::run(workflow::NodeContext& context) {

@@ -143,100 +143,94 @@ workflow::NodeSpec WrapMuscles::spec() {
   using workflow::port::File;
   using workflow::port::Report;
   const wrapping::MuscleWrappingOptions d;
-  return workflow::NodeSpec{"wrap_muscles", 6,
-                            "Muscle wrapping over a fused motion (energy pathway): per frame, "
-                            "action lines re-routed on the "
-                            "moving skeleton; each muscle surface deformed around them with its "
-                            "volume held exactly (Gauss-Newton "
-                            "with a Lagrange multiplier) and contacts found inside the iterations "
-                            "keeping it out of the bones"}
-      .input<Atlas>("atlas", "The (scaled) atlas the motion drives")
-      .input<BonePoses>("motion", "Fused motion of this atlas (fuse_motion with the atlas input)")
-      .optional_input<File>("hulls",
-                            "Stored progressive hulls (build_hulls); a muscle whose hull is "
-                            "missing or was built from another surface gets a new one")
-      .param<std::int64_t>(
-          "target_faces", d.target_faces,
-          "Wrapping resolution: each muscle's full mesh decimated to this many faces "
-          "(0: the full mesh)",
-          {.min = 0, .max = 1000000})
-      .param<bool>("bone_contacts", d.bone_contacts,
-                   "Keep the muscles out of the bones (impenetrability)")
-      .param<bool>("muscle_penetration", d.muscle_penetration,
-                   "Measure how far the muscles run into each other beyond their overlap at "
-                   "rest (a metric; muscle_contacts measures it too)")
-      .param<bool>("muscle_contacts", d.muscle_contacts,
-                   "Keep the muscles out of each other: overlaps at rest resolved once, then "
-                   "per pose, two overlapping muscles meet between their surfaces (slower: "
-                   "the muscles go pose by pose together)")
-      .param<double>("muscle_contact_weight", d.muscle_contact.weight,
-                     "How firmly a vertex in contact with another muscle is held (bone "
-                     "contacts: 10000); softer keeps surfaces smoother, firmer closer",
-                     {.min = 0.01, .max = 1e6})
-      .param<std::int64_t>("muscle_contact_rounds", d.muscle_contact_rounds,
-                           "Rounds of contacts between muscles per pose", {.min = 1, .max = 10})
-      .param<std::int64_t>("muscle_contact_settling_rounds", d.muscle_contact_settling_rounds,
-                           "Rounds solver: after those rounds, while a muscle is still inside "
-                           "another, up to this many in which only such muscles move, pinned "
-                           "onto the surface they entered as firmly as to a bone; each pose "
-                           "keeps the surfaces with the shallowest entry (0: none)",
-                           {.min = 0, .max = 50})
-      .param_enum("muscle_contact_solver", "rounds", {"rounds", "joint"},
-                  "With muscle_contacts: rounds of shared pins, each muscle solved against the "
-                  "others' surfaces of the round before; or the touching muscles solved together "
-                  "in one system, both sides of a contact moving at once (smoother, many times "
-                  "slower)")
-      .param<std::int64_t>("joint_contact_rounds", d.joint_rounds,
-                           "Joint solver: solves per pose with the contacts grown",
-                           {.min = 1, .max = 50})
-      .param<double>("muscle_interface_reach_mm", d.muscle_interface_reach_mm,
-                     "With muscle_contacts: muscles this close at rest share their motion "
-                     "across the interface, so the skeleton does not drive them into each "
-                     "other (0: each follows its own action lines)",
-                     {.min = 0, .max = 100}, "mm")
-      .param_enum("path_method", "obstacle_set", {"obstacle_set", "global"},
-                  "Action-line paths: straight between the path points and wrapped over the "
-                  "atlas's fitted obstacles, or the shortest path keeping clear of the bone "
-                  "meshes themselves (Ceres)")
-      .param<double>("path_clearance_mm", d.routing.global.clearance_mm,
-                     "Global paths keep this distance from every bone", {.min = 0, .max = 20}, "mm")
-      .param<bool>("coarse_to_fine", d.coarse_to_fine,
-                   "Solve each muscle's progressive hull first, then its surface from there")
-      .param<std::int64_t>("hull_faces", d.hull_faces, "Faces of the progressive hulls",
-                           {.min = 4, .max = 1000000})
-      .param<std::int64_t>("intermediate_poses", d.intermediate_poses,
-                           "Interpolated variant: poses solved between consecutive frames first",
-                           {.min = 0, .max = 50})
-      .param<std::int64_t>("first_frame_intermediate_poses", d.first_frame_intermediate_poses,
-                           "Poses solved between the rest pose and the first frame",
-                           {.min = 0, .max = 100})
-      .param<std::string>("muscles", "",
-                          "Comma-separated muscle names; empty: every muscle of the atlas")
-      .param<double>("stiffness_length_mm", d.deformer.stiffness_length_mm,
-                     "How far a local push (a contact) spreads over the surface",
-                     {.min = 0.5, .max = 500}, "mm")
-      .param<double>("contact_tolerance_mm", d.contacts.tolerance_mm,
-                     "A vertex deeper than this in a bone becomes a contact", {.min = 0, .max = 5},
-                     "mm")
-      .param<double>("contact_clearance_mm", d.contacts.clearance_mm,
-                     "Contacts are pinned this far outside the bone", {.min = 0, .max = 5}, "mm")
-      .param<std::int64_t>("threads", 0, "Worker threads (muscles in parallel); 0: the machine's",
-                           {.min = 0, .max = 64})
-      .param<std::int64_t>(
-          "animation_stride", 5,
-          "The animation holds every n-th frame (ASCII .vtp: every frame of 21 muscles "
-          "over a 2 s walk is ~1.8 GB)",
-          {.min = 1, .max = 1000})
-      .param<std::string>("bone_level", "lod2",
-                          "Atlas mesh level of the bones drawn in the animation")
-      .output<File>("animation",
-                    "Folder bundle of a ParaView animation (wrapping.pvd + .vtp per frame)")
-      .output<File>(
-          "metrics",
-          "CSV per muscle and frame: volume error, penetration, contacts, smoothness, time")
-      .output<File>("lines", "CSV per action line and frame: length and moment arms (hip, knee)")
-      .output<File>("plot", "SVG: volume error, penetration depth, time and bending per frame")
-      .output<Report>("report", "Per-muscle summaries, targets, timings");
+  workflow::NodeSpec spec =
+      workflow::NodeSpec{"wrap_muscles", 6,
+                         "Muscle wrapping over a fused motion (energy pathway): per frame, "
+                         "action lines re-routed on the "
+                         "moving skeleton; each muscle surface deformed around them with its "
+                         "volume held exactly (Gauss-Newton "
+                         "with a Lagrange multiplier) and contacts found inside the iterations "
+                         "keeping it out of the bones"}
+          .input<Atlas>("atlas", "The (scaled) atlas the motion drives")
+          .input<BonePoses>("motion",
+                            "Fused motion of this atlas (fuse_motion with the atlas input)")
+          .optional_input<File>("hulls",
+                                "Stored progressive hulls (build_hulls); a muscle whose hull is "
+                                "missing or was built from another surface gets a new one")
+          .param<std::int64_t>(
+              "target_faces", d.target_faces,
+              "Wrapping resolution: each muscle's full mesh decimated to this many faces "
+              "(0: the full mesh)",
+              {.min = 0, .max = 1000000})
+          .param<bool>("bone_contacts", d.bone_contacts,
+                       "Keep the muscles out of the bones (impenetrability)")
+          .param<bool>("muscle_penetration", d.muscle_penetration,
+                       "Measure how far the muscles run into each other beyond their overlap at "
+                       "rest (a metric; muscle_contacts measures it too)")
+          .param<bool>("muscle_contacts", d.muscle_contacts,
+                       "Keep the muscles out of each other: overlaps at rest resolved once, then "
+                       "per pose, two overlapping muscles meet between their surfaces (slower: "
+                       "the muscles go pose by pose together)")
+          .param<double>("muscle_contact_weight", d.muscle_contact.weight,
+                         "How firmly a vertex in contact with another muscle is held (bone "
+                         "contacts: 10000); softer keeps surfaces smoother, firmer closer",
+                         {.min = 0.01, .max = 1e6})
+          .param<std::int64_t>("muscle_contact_rounds", d.muscle_contact_rounds,
+                               "Rounds of contacts between muscles per pose", {.min = 1, .max = 10})
+          .param<std::int64_t>("muscle_contact_settling_rounds", d.muscle_contact_settling_rounds,
+                               "Rounds solver: after those rounds, while a muscle is still inside "
+                               "another, up to this many in which only such muscles move, pinned "
+                               "onto the surface they entered as firmly as to a bone; each pose "
+                               "keeps the surfaces with the shallowest entry (0: none)",
+                               {.min = 0, .max = 50})
+          .param_enum(
+              "muscle_contact_solver", "rounds", {"rounds", "joint"},
+              "With muscle_contacts: rounds of shared pins, each muscle solved against the "
+              "others' surfaces of the round before; or the touching muscles solved together "
+              "in one system, both sides of a contact moving at once (smoother, many times "
+              "slower)")
+          .param<std::int64_t>("joint_contact_rounds", d.joint_rounds,
+                               "Joint solver: solves per pose with the contacts grown",
+                               {.min = 1, .max = 50})
+          .param<double>("muscle_interface_reach_mm", d.muscle_interface_reach_mm,
+                         "With muscle_contacts: muscles this close at rest share their motion "
+                         "across the interface, so the skeleton does not drive them into each "
+                         "other (0: each follows its own action lines)",
+                         {.min = 0, .max = 100}, "mm")
+          .param_enum("path_method", "obstacle_set", {"obstacle_set", "global"},
+                      "Action-line paths: straight between the path points and wrapped over the "
+                      "atlas's fitted obstacles, or the shortest path keeping clear of the bone "
+                      "meshes themselves (Ceres)")
+          .param<double>("path_clearance_mm", d.routing.global.clearance_mm,
+                         "Global paths keep this distance from every bone", {.min = 0, .max = 20},
+                         "mm")
+          .param<bool>("coarse_to_fine", d.coarse_to_fine,
+                       "Solve each muscle's progressive hull first, then its surface from there")
+          .param<std::int64_t>("hull_faces", d.hull_faces, "Faces of the progressive hulls",
+                               {.min = 4, .max = 1000000})
+          .param<std::int64_t>(
+              "intermediate_poses", d.intermediate_poses,
+              "Interpolated variant: poses solved between consecutive frames first",
+              {.min = 0, .max = 50})
+          .param<std::int64_t>("first_frame_intermediate_poses", d.first_frame_intermediate_poses,
+                               "Poses solved between the rest pose and the first frame",
+                               {.min = 0, .max = 100})
+          .param<std::string>("muscles", "",
+                              "Comma-separated muscle names; empty: every muscle of the atlas")
+          .param<double>("stiffness_length_mm", d.deformer.stiffness_length_mm,
+                         "How far a local push (a contact) spreads over the surface",
+                         {.min = 0.5, .max = 500}, "mm")
+          .param<double>("contact_tolerance_mm", d.contacts.tolerance_mm,
+                         "A vertex deeper than this in a bone becomes a contact",
+                         {.min = 0, .max = 5}, "mm")
+          .param<double>("contact_clearance_mm", d.contacts.clearance_mm,
+                         "Contacts are pinned this far outside the bone", {.min = 0, .max = 5},
+                         "mm")
+          .param<std::int64_t>("threads", 0,
+                               "Worker threads (muscles in parallel); 0: the machine's",
+                               {.min = 0, .max = 64});
+  add_wrapping_outputs(spec);
+  return spec.output<Report>("report", "Per-muscle summaries, targets, timings");
 }
 
 void WrapMuscles::run(workflow::NodeContext& context) {

@@ -150,6 +150,25 @@ motion::FusedMotion atlas_motion_input(const workflow::NodeContext& context,
   return fused;
 }
 
+workflow::NodeSpec& add_wrapping_outputs(workflow::NodeSpec& spec) {
+  using workflow::port::File;
+  return spec
+      .param<std::int64_t>(
+          "animation_stride", 5,
+          "The animation holds every n-th frame (ASCII .vtp: every frame of 21 muscles "
+          "over a 2 s walk is ~1.8 GB)",
+          {.min = 1, .max = 1000})
+      .param<std::string>("bone_level", "lod2",
+                          "Atlas mesh level of the bones drawn in the animation")
+      .output<File>("animation",
+                    "Folder bundle of a ParaView animation (wrapping.pvd + .vtp per frame)")
+      .output<File>(
+          "metrics",
+          "CSV per muscle and frame: volume error, penetration, contacts, smoothness, time")
+      .output<File>("lines", "CSV per action line and frame: length and moment arms (hip, knee)")
+      .output<File>("plot", "SVG: volume error, penetration depth, time and bending per frame");
+}
+
 void set_wrapping_outputs(workflow::NodeContext& context, const wrapping::MuscleWrapping& wrapped,
                           const atlas::Atlas& atlas, const std::filesystem::path& atlas_dir,
                           const std::string& plot_title) {

@@ -11,6 +11,7 @@
 #include "core/motion/motion_fusion.h"
 #include "core/wrapping/muscle_wrapping.h"
 #include "workflow/node_context.h"
+#include "workflow/node_spec.h"
 
 namespace mmm::nodes {
 
@@ -19,6 +20,11 @@ namespace mmm::nodes {
 // JSON, not a motion, or drives an OpenSim model instead of an atlas.
 motion::FusedMotion atlas_motion_input(const workflow::NodeContext& context,
                                        const std::string& node);
+
+// Declares the parameters 'animation_stride' and 'bone_level' and the
+// outputs 'animation', 'metrics', 'lines' and 'plot' that
+// set_wrapping_outputs fills.
+workflow::NodeSpec& add_wrapping_outputs(workflow::NodeSpec& spec);
 
 // Sets the outputs 'metrics', 'lines', 'plot' (titled `plot_title`) and
 // 'animation' (parameters 'bone_level' and 'animation_stride').

@@ -122,7 +122,8 @@ TEST(WorkflowCliTest, NodesJsonIsMachineReadable) {
                        "build_hulls", "build_muscle_lattice", "decimate_mesh", "decompose_fibres",
                        "fit_bone_outlines", "fuse_motion", "import_markups", "landmark_report",
                        "landmark_station", "load_mesh", "load_radiographs", "measure_mesh",
-                       "outline_review", "scale_atlas", "static_trial_landmarks", "wrap_muscles"}))
+                       "outline_review", "scale_atlas", "simulate_muscles",
+                       "static_trial_landmarks", "wrap_muscles"}))
       << "sorted by name";
   const auto& decimate = json["node_types"][2];
   EXPECT_EQ(decimate["name"], "decimate_mesh");
