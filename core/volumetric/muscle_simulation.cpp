@@ -9,11 +9,11 @@
 
 #include "core/atlas/atlas_io.h"
 #include "core/errors.h"
-#include "core/mesh/aabb_tree.h"
 #include "core/mesh/laplacian.h"
 #include "core/motion/skeleton.h"
 #include "core/parallel_for.h"
 #include "core/volumetric/coarse_embedding.h"
+#include "core/volumetric/rest_binding.h"
 #include "core/wrapping/muscle_penetration.h"
 #include "core/wrapping/posed_skeleton.h"
 
@@ -67,183 +67,6 @@ LabelledLattice select_muscles(const LabelledLattice& stored,
   return out;
 }
 
-// The surface of label l + 1 on its own nodes: faces renumbered, and the
-// output nodes they came from.
-struct MuscleSurface {
-  mesh::IndexedMesh rest;
-  std::vector<int> nodes;  // output node per vertex
-};
-
-MuscleSurface muscle_surface(const TetMesh& output, std::uint16_t label) {
-  const mesh::IndexedMesh boundary = label_boundary(output, label);
-  MuscleSurface out;
-  std::vector<int> vertex(static_cast<std::size_t>(output.V.rows()), -1);
-  out.rest.F.resize(boundary.F.rows(), 3);
-  for (Eigen::Index f = 0; f < boundary.F.rows(); ++f) {
-    for (int c = 0; c < 3; ++c) {
-      int& v = vertex[static_cast<std::size_t>(boundary.F(f, c))];
-      if (v < 0) {
-        v = static_cast<int>(out.nodes.size());
-        out.nodes.push_back(boundary.F(f, c));
-      }
-      out.rest.F(f, c) = v;
-    }
-  }
-  out.rest.V.resize(static_cast<Eigen::Index>(out.nodes.size()), 3);
-  for (std::size_t v = 0; v < out.nodes.size(); ++v)
-    out.rest.V.row(static_cast<Eigen::Index>(v)) = output.V.row(out.nodes[v]);
-  return out;
-}
-
-// The boundary nodes of a muscle within `reach` of one of its attachment
-// areas follow that area's bone. An area farther than that from every node
-// is reached through a tendon the segmentation does not hold (the
-// quadriceps' insertion on the tibia, the triceps surae's on the calcaneus):
-// tying the belly's end rigidly to that bone would drag it around the joint,
-// so the area is left out and the end follows the tissue around it. `gap`
-// receives the largest distance from an area to the muscle, `left_out` the
-// areas left out.
-std::vector<DrivenNode> attachments(const atlas::Muscle& muscle, const MuscleSurface& surface,
-                                    const wrapping::PosedBones& bones,
-                                    const std::vector<int>& taken, double reach, double& gap,
-                                    int& left_out) {
-  std::vector<DrivenNode> out;
-  gap = 0.0;
-  for (const auto* areas : {&muscle.origins, &muscle.insertions}) {
-    for (const atlas::AttachmentArea& area : *areas) {
-      const auto bone = bones.index.find(area.bone);
-      if (bone == bones.index.end() || area.faces.empty()) continue;
-      const mesh::IndexedMesh& full =
-          bones.surfaces[static_cast<std::size_t>(bone->second)].surface->tree().mesh();
-      mesh::IndexedMesh patch;
-      patch.V = full.V;
-      patch.F.resize(static_cast<Eigen::Index>(area.faces.size()), 3);
-      for (std::size_t f = 0; f < area.faces.size(); ++f) {
-        if (area.faces[f] < 0 || area.faces[f] >= full.F.rows()) {
-          throw InvalidInputError("muscle simulation: an attachment area of '" + muscle.name +
-                                  "' names face " + std::to_string(area.faces[f]) + " of bone '" +
-                                  area.bone + "', which has " + std::to_string(full.F.rows()));
-        }
-        patch.F.row(static_cast<Eigen::Index>(f)) = full.F.row(area.faces[f]);
-      }
-      const mesh::AabbTree tree(patch);
-      std::vector<double> distance(surface.nodes.size());
-      double nearest = std::numeric_limits<double>::infinity();
-      for (std::size_t v = 0; v < surface.nodes.size(); ++v) {
-        distance[v] = std::sqrt(
-            tree.closest_point(surface.rest.V.row(static_cast<Eigen::Index>(v)).transpose())
-                .squared_distance);
-        nearest = std::min(nearest, distance[v]);
-      }
-      gap = std::max(gap, nearest);
-      if (nearest > reach) {
-        ++left_out;
-        continue;
-      }
-      for (std::size_t v = 0; v < surface.nodes.size(); ++v) {
-        const int node = surface.nodes[v];
-        if (distance[v] <= reach && taken[static_cast<std::size_t>(node)] < 0)
-          out.push_back({node, bone->second});
-      }
-    }
-  }
-  return out;
-}
-
-// Output nodes on a muscle's boundary inside a bone at rest, or nearer it
-// than `clearance`, moved onto the bone's surface plus the clearance: a
-// lattice's staircase reaches up to half a cell diagonal into a bone.
-// Returns the largest move (mm) and counts the nodes moved.
-double move_out_of_bones(EmbeddedModel& model, const std::vector<int>& boundary_nodes,
-                         const wrapping::PosedBones& bones, double clearance, double cell,
-                         int threads, int& moved_count) {
-  std::vector<Eigen::Vector3d> target(boundary_nodes.size());
-  std::vector<char> moved(boundary_nodes.size(), 0);
-  parallel_for(boundary_nodes.size(), threads, [&](std::size_t k) {
-    Eigen::Vector3d p = model.output.V.row(boundary_nodes[k]).transpose();
-    for (const wrapping::PosableBone& bone : bones.surfaces) {
-      const mesh::SignedDistance& sdf = *bone.surface;
-      const auto near = sdf.tree().closest_point_within(p, (cell + clearance) * (cell + clearance));
-      if (!near) continue;
-      const double length = std::sqrt(near->squared_distance);
-      const bool inside = sdf.winding().is_inside(p);
-      if (!inside && length >= clearance) continue;
-      if (length < 1e-12) continue;
-      const Eigen::Vector3d out = (inside ? -1.0 : 1.0) * (p - near->point) / length;
-      p = near->point + clearance * out;
-      moved[k] = 1;
-    }
-    target[k] = p;
-  });
-  std::vector<int> nodes;
-  std::vector<Eigen::Vector3d> positions;
-  double largest = 0.0;
-  for (std::size_t k = 0; k < boundary_nodes.size(); ++k) {
-    if (moved[k] == 0) continue;
-    largest =
-        std::max(largest, (target[k] - model.output.V.row(boundary_nodes[k]).transpose()).norm());
-    nodes.push_back(boundary_nodes[k]);
-    positions.push_back(target[k]);
-  }
-  Eigen::MatrixX3d rows(static_cast<Eigen::Index>(positions.size()), 3);
-  for (std::size_t k = 0; k < positions.size(); ++k)
-    rows.row(static_cast<Eigen::Index>(k)) = positions[k].transpose();
-  move_output_nodes(model, nodes, rows);
-  moved_count = static_cast<int>(nodes.size());
-  return largest;
-}
-
-// Element nodes inside a bone at rest follow it: an element reaching into
-// a bone (across a thin wing, say) moves with the bone instead of being
-// pushed out of it on both sides.
-std::vector<DrivenNode> element_anchors(const TetMesh& elements, const wrapping::PosedBones& bones,
-                                        double reach, double joint_clearance, int threads) {
-  std::vector<int> bone_of(static_cast<std::size_t>(elements.V.rows()), -1);
-  parallel_for(bone_of.size(), threads, [&](std::size_t i) {
-    const Eigen::Vector3d p = elements.V.row(static_cast<Eigen::Index>(i)).transpose();
-    for (std::size_t b = 0; b < bones.surfaces.size(); ++b) {
-      const mesh::SignedDistance& sdf = *bones.surfaces[b].surface;
-      if (sdf.tree().closest_point_within(p, reach * reach) && sdf.winding().is_inside(p)) {
-        bone_of[i] = static_cast<int>(b);
-        break;
-      }
-    }
-    // Near a joint the tissue slides over both bones: not anchored.
-    if (bone_of[i] < 0 || !(joint_clearance > 0)) return;
-    for (std::size_t b = 0; b < bones.surfaces.size(); ++b) {
-      if (static_cast<int>(b) == bone_of[i] ||
-          bones.bodies[b] == bones.bodies[static_cast<std::size_t>(bone_of[i])]) {
-        continue;
-      }
-      if (bones.surfaces[b].surface->tree().closest_point_within(
-              p, joint_clearance * joint_clearance)) {
-        bone_of[i] = -1;
-        return;
-      }
-    }
-  });
-  // An element reaching into two bones (tissue between the ischium and the
-  // femur, say) cannot follow both: its corners are left to the contacts.
-  std::vector<char> torn(bone_of.size(), 0);
-  for (Eigen::Index t = 0; t < elements.T.rows(); ++t) {
-    int first = -1;
-    bool two = false;
-    for (int c = 0; c < 4; ++c) {
-      const int bone = bone_of[static_cast<std::size_t>(elements.T(t, c))];
-      if (bone < 0) continue;
-      if (first >= 0 && bone != first) two = true;
-      first = bone;
-    }
-    if (!two) continue;
-    for (int c = 0; c < 4; ++c) torn[static_cast<std::size_t>(elements.T(t, c))] = 1;
-  }
-  std::vector<DrivenNode> out;
-  for (std::size_t i = 0; i < bone_of.size(); ++i) {
-    if (bone_of[i] >= 0 && torn[i] == 0) out.push_back({static_cast<int>(i), bone_of[i], true});
-  }
-  return out;
-}
-
 double bending(const Eigen::SparseMatrix<double>& laplacian, const Eigen::MatrixX3d& x) {
   return (laplacian * x).squaredNorm();
 }
@@ -259,6 +82,63 @@ void check_options(const MuscleSimulationOptions& options) {
   if (options.first_frame_intermediate_poses < 0) {
     throw InvalidInputError("muscle simulation: first_frame_intermediate_poses must be >= 0");
   }
+}
+
+// Ties the model to the skeleton at rest (rest_binding.h): the muscles'
+// surfaces (into `surfaces`), moved out of the bones; their attachment
+// nodes; the element nodes anchored in the bones. Returns every driven node
+// and records the counts in `result`.
+std::vector<DrivenNode> bind_at_rest(EmbeddedModel& model,
+                                     const std::vector<const atlas::Muscle*>& muscles,
+                                     const wrapping::PosedBones& bones, double spacing,
+                                     const MuscleSimulationOptions& options, int threads,
+                                     std::vector<MuscleSurface>& surfaces,
+                                     MuscleSimulation& result) {
+  surfaces.resize(muscles.size());
+  parallel_for(muscles.size(), threads, [&](std::size_t m) {
+    surfaces[m] = muscle_surface(model.output, static_cast<std::uint16_t>(m + 1));
+  });
+  {
+    std::vector<char> on_boundary(static_cast<std::size_t>(model.output.V.rows()), 0);
+    for (const MuscleSurface& surface : surfaces) {
+      for (const int node : surface.nodes) on_boundary[static_cast<std::size_t>(node)] = 1;
+    }
+    std::vector<int> boundary_nodes;
+    for (std::size_t i = 0; i < on_boundary.size(); ++i) {
+      if (on_boundary[i] != 0) boundary_nodes.push_back(static_cast<int>(i));
+    }
+    result.rest_moved_out_of_bones_mm =
+        move_out_of_bones(model, boundary_nodes, bones, options.rest_clearance_mm,
+                          spacing * std::sqrt(3.0), threads, result.rest_moved_nodes);
+    for (MuscleSurface& surface : surfaces) {
+      for (std::size_t v = 0; v < surface.nodes.size(); ++v)
+        surface.rest.V.row(static_cast<Eigen::Index>(v)) = model.output.V.row(surface.nodes[v]);
+    }
+    const Eigen::VectorXd volumes = tet_volumes(model.output);
+    result.rest_inverted_output = static_cast<int>((volumes.array() <= 0.0).count());
+  }
+  std::vector<DrivenNode> driven;
+  std::vector<int> taken(static_cast<std::size_t>(model.output.V.rows()), -1);
+  for (std::size_t m = 0; m < muscles.size(); ++m) {
+    double gap = 0.0;
+    int left_out = 0;
+    const std::vector<DrivenNode> own = attachments(*muscles[m], surfaces[m], bones, taken,
+                                                    options.attachment_reach_mm, gap, left_out);
+    result.attachment_gap_mm.push_back(gap);
+    result.attachments_left_out.push_back(left_out);
+    for (const DrivenNode& d : own) taken[static_cast<std::size_t>(d.node)] = d.bone;
+    result.driven_per_muscle.push_back(static_cast<int>(own.size()));
+    driven.insert(driven.end(), own.begin(), own.end());
+  }
+  result.driven_nodes = static_cast<int>(driven.size());
+  const std::vector<DrivenNode> anchors =
+      !options.anchor_elements_in_bones
+          ? std::vector<DrivenNode>{}
+          : element_anchors(model.elements, bones, spacing * options.coarsening * std::sqrt(3.0),
+                            options.anchor_joint_clearance_mm, threads);
+  result.anchored_element_nodes = static_cast<int>(anchors.size());
+  driven.insert(driven.end(), anchors.begin(), anchors.end());
+  return driven;
 }
 
 }  // namespace
@@ -304,51 +184,9 @@ MuscleSimulation simulate_muscles(const atlas::Atlas& atlas, const std::filesyst
   result.coarsening = options.coarsening;
   EmbeddedModel model = embed_in_coarse_lattice(labels, options.coarsening);
 
-  std::vector<MuscleSurface> surfaces(muscles.size());
-  parallel_for(muscles.size(), threads, [&](std::size_t m) {
-    surfaces[m] = muscle_surface(model.output, static_cast<std::uint16_t>(m + 1));
-  });
-  {
-    std::vector<char> on_boundary(static_cast<std::size_t>(model.output.V.rows()), 0);
-    for (const MuscleSurface& surface : surfaces) {
-      for (const int node : surface.nodes) on_boundary[static_cast<std::size_t>(node)] = 1;
-    }
-    std::vector<int> boundary_nodes;
-    for (std::size_t i = 0; i < on_boundary.size(); ++i) {
-      if (on_boundary[i] != 0) boundary_nodes.push_back(static_cast<int>(i));
-    }
-    result.rest_moved_out_of_bones_mm =
-        move_out_of_bones(model, boundary_nodes, bones, options.rest_clearance_mm,
-                          labels.spacing_mm * std::sqrt(3.0), threads, result.rest_moved_nodes);
-    for (MuscleSurface& surface : surfaces) {
-      for (std::size_t v = 0; v < surface.nodes.size(); ++v)
-        surface.rest.V.row(static_cast<Eigen::Index>(v)) = model.output.V.row(surface.nodes[v]);
-    }
-    const Eigen::VectorXd volumes = tet_volumes(model.output);
-    result.rest_inverted_output = static_cast<int>((volumes.array() <= 0.0).count());
-  }
-  std::vector<DrivenNode> driven;
-  std::vector<int> taken(static_cast<std::size_t>(model.output.V.rows()), -1);
-  for (std::size_t m = 0; m < muscles.size(); ++m) {
-    double gap = 0.0;
-    int left_out = 0;
-    const std::vector<DrivenNode> own = attachments(*muscles[m], surfaces[m], bones, taken,
-                                                    options.attachment_reach_mm, gap, left_out);
-    result.attachment_gap_mm.push_back(gap);
-    result.attachments_left_out.push_back(left_out);
-    for (const DrivenNode& d : own) taken[static_cast<std::size_t>(d.node)] = d.bone;
-    result.driven_per_muscle.push_back(static_cast<int>(own.size()));
-    driven.insert(driven.end(), own.begin(), own.end());
-  }
-  result.driven_nodes = static_cast<int>(driven.size());
-  const std::vector<DrivenNode> anchors =
-      !options.anchor_elements_in_bones
-          ? std::vector<DrivenNode>{}
-          : element_anchors(model.elements, bones,
-                            labels.spacing_mm * options.coarsening * std::sqrt(3.0),
-                            options.anchor_joint_clearance_mm, threads);
-  result.anchored_element_nodes = static_cast<int>(anchors.size());
-  driven.insert(driven.end(), anchors.begin(), anchors.end());
+  std::vector<MuscleSurface> surfaces;
+  const std::vector<DrivenNode> driven =
+      bind_at_rest(model, muscles, bones, labels.spacing_mm, options, threads, surfaces, result);
   result.element_nodes = model.elements.V.rows();
   result.elements = model.elements.T.rows();
   result.output_nodes = model.output.V.rows();
