@@ -195,12 +195,10 @@ workflow::NodeSpec SimulateMuscles::spec() {
   workflow::NodeSpec spec =
       workflow::NodeSpec{"simulate_muscles", 1,
                          "Muscle wrapping over a fused motion (volumetric pathway): every muscle "
-                         "in one conforming "
-                         "tetrahedral model, touching muscles sharing their interface, moved by "
-                         "the bones frame by "
-                         "frame (projective dynamics), each muscle's volume restored exactly, "
-                         "attachments following "
-                         "their bones, surfaces kept out of the bones"}
+                         "in one conforming tetrahedral model, touching muscles sharing their "
+                         "interface, moved by the bones frame by frame (projective dynamics), "
+                         "each muscle's volume restored exactly, attachments following their "
+                         "bones, surfaces kept out of the bones"}
           .input<Atlas>("atlas", "The (scaled) atlas the motion drives")
           .input<BonePoses>("motion",
                             "Fused motion of this atlas (fuse_motion with the atlas input)")
