@@ -472,16 +472,16 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
   };
   std::vector<Vector3d> contact_target(s.contacts.size());
   FrameStats stats;
-  using Clock = std::chrono::steady_clock;
-  const auto lap = [](Clock::time_point& since) {
-    const Clock::time_point now = Clock::now();
+  using StepClock = std::chrono::steady_clock;
+  const auto lap = [](StepClock::time_point& since) {
+    const StepClock::time_point now = StepClock::now();
     const double elapsed = std::chrono::duration<double>(now - since).count();
     since = now;
     return elapsed;
   };
   s.y = weights * s.x;
   for (int iteration = 0; iteration < o.iterations; ++iteration) {
-    Clock::time_point since = Clock::now();
+    StepClock::time_point since = StepClock::now();
     parallel_for(static_cast<std::size_t>(tets), o.threads, [&](std::size_t t) {
       const auto i = static_cast<Eigen::Index>(t);
       Eigen::Matrix<double, 4, 3> corners;
