@@ -17,13 +17,11 @@
 #include "core/fibres/fibre_mapping.h"
 #include "core/fibres/fibre_quality.h"
 #include "core/fibres/muscle_fibres.h"
-#include "core/fit/rigid_fit.h"
 #include "core/image/png.h"
 #include "core/mesh/io/mesh_io.h"
-#include "core/mesh/io/pvd.h"
-#include "core/mesh/io/vtp.h"
 #include "core/mesh/io/vtp_series.h"
 #include "core/parallel_for.h"
+#include "core/wrapping/muscle_frames.h"
 #include "core/wrapping/muscle_hulls.h"
 #include "core/wrapping/muscle_wrapping.h"
 #include "nodes/fibre_picture.h"
@@ -55,72 +53,6 @@ std::map<std::string, DecompositionMethod> method_overrides(const std::string& t
   }
   return overrides;
 }
-
-// One frame of a wrap_muscles animation: time, and the file of each part.
-struct AnimationFrame {
-  double time = 0.0;
-  std::map<std::string, std::filesystem::path> parts;
-};
-
-std::vector<AnimationFrame> animation_frames(const std::filesystem::path& folder) {
-  const std::filesystem::path pvd = folder / "wrapping.pvd";
-  if (!std::filesystem::exists(pvd)) {
-    throw InvalidInputError(
-        "decompose_fibres: input 'animation' has no wrapping.pvd; hint: connect wrap_muscles's "
-        "'animation' output");
-  }
-  std::vector<AnimationFrame> frames;
-  for (const mesh::PvdEntry& entry : mesh::read_pvd(pvd)) {
-    if (frames.empty() || frames.back().time != entry.time) frames.push_back({entry.time, {}});
-    frames.back().parts[entry.name] = folder / entry.file;
-  }
-  return frames;
-}
-
-// A bone's rest -> frame transform from its drawn surface: the atlas level
-// with as many vertices, rigidly fitted onto the frame's copy. Fitted once
-// per bone and frame, however many muscles attach to the bone.
-class BonePoses {
- public:
-  BonePoses(const atlas::Atlas& atlas, std::filesystem::path atlas_dir)
-      : atlas_(atlas), atlas_dir_(std::move(atlas_dir)) {}
-
-  // Safe to call from several threads.
-  Eigen::Isometry3d pose(const std::string& bone, std::size_t index, const AnimationFrame& frame) {
-    const std::scoped_lock lock(mutex_);
-    const auto known = poses_.find({bone, index});
-    if (known != poses_.end()) return known->second;
-    const auto part = frame.parts.find(bone);
-    if (part == frame.parts.end()) {
-      throw InvalidInputError("decompose_fibres: the animation has no bone '" + bone +
-                              "' at time " + fixed(frame.time, 4) + "; hint: wrap the same atlas");
-    }
-    const mesh::IndexedMesh posed = mesh::read_vtp(part->second);
-    Eigen::Isometry3d fitted = fit::rigid_fit(rest_level(bone, posed.V.rows()), posed.V).rigid;
-    poses_.emplace(std::pair{bone, index}, fitted);
-    return fitted;
-  }
-
- private:
-  const Eigen::MatrixX3d& rest_level(const std::string& bone, Eigen::Index vertices) {
-    const std::string key = bone + "#" + std::to_string(vertices);
-    if (const auto found = cache_.find(key); found != cache_.end()) return found->second;
-    const atlas::Bone* b = atlas_.find_bone(bone);
-    for (const atlas::MeshLevel& level : b->meshes) {
-      mesh::IndexedMesh m = mesh::read_mesh(atlas_dir_ / level.file);
-      if (m.V.rows() == vertices) return cache_.emplace(key, std::move(m.V)).first->second;
-    }
-    throw InvalidInputError("decompose_fibres: bone '" + bone + "' of the animation has " +
-                            std::to_string(vertices) +
-                            " vertices, no level of the atlas's bone has; hint: wrap this atlas");
-  }
-
-  const atlas::Atlas& atlas_;
-  std::filesystem::path atlas_dir_;
-  std::mutex mutex_;
-  std::map<std::string, Eigen::MatrixX3d> cache_;
-  std::map<std::pair<std::string, std::size_t>, Eigen::Isometry3d> poses_;
-};
 
 mesh::Polylines as_polylines(const std::vector<fibres::Fibre>& fibres) {
   mesh::Polylines lines;
@@ -157,17 +89,19 @@ struct MuscleResult {
 workflow::NodeSpec DecomposeFibres::spec() {
   using workflow::port::Atlas;
   using workflow::port::File;
+  using workflow::port::MuscleFrames;
   using workflow::port::Report;
   const fibres::DecompositionOptions d;
   const wrapping::MuscleWrappingOptions w;
   return workflow::NodeSpec{
-      "decompose_fibres", 1,
+      "decompose_fibres", 2,
       "Every muscle's volume filled with fibres (slicing, harmonic, mass-spring or cadaver "
       "method), at rest and in every frame of a wrapped motion"}
       .input<Atlas>("atlas", "The (scaled) atlas")
-      .optional_input<File>("animation",
-                            "wrap_muscles's animation of this atlas: its frames are decomposed "
-                            "(the fibres follow the wrapped muscles)")
+      .optional_input<MuscleFrames>(
+          "wrapped",
+          "A wrapping node's wrapped motion of this atlas (wrap_muscles or simulate_muscles): "
+          "each muscle is decomposed on its rest surface there, then in every stored frame")
       .param_enum("method", "slicing", {"slicing", "harmonic", "mass_spring", "cadaver"},
                   "Decomposition method of every muscle (cadaver: this atlas has no measured "
                   "fibres, so four stand-ins traced on the muscle are used)")
@@ -179,7 +113,8 @@ workflow::NodeSpec DecomposeFibres::spec() {
                            {.min = 9, .max = 10000})
       .param<std::int64_t>("segments", d.segments, "Segments per fibre", {.min = 2, .max = 1000})
       .param<std::int64_t>("target_faces", w.target_faces,
-                           "Muscle surface resolution, as wrap_muscles's target_faces (0: full)",
+                           "Muscle surface resolution, as wrap_muscles's target_faces (0: full); "
+                           "with a wrapped motion, its rest surfaces are used instead",
                            {.min = 0, .max = 1000000})
       .param<std::string>("muscles", "",
                           "Comma-separated muscle names; empty: every muscle of the atlas")
@@ -220,14 +155,18 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
     }
     return found->second;
   };
-  std::vector<AnimationFrame> frames;
-  std::filesystem::path animation_dir;
-  if (context.has_input("animation")) {
-    animation_dir = context.scratch_dir() / "animation";
-    unpack_directory(context.input_bytes("animation"), animation_dir, "input 'animation'");
-    frames = animation_frames(animation_dir);
+  wrapping::MuscleFrames wrapped;
+  if (context.has_input("wrapped")) {
+    wrapped = wrapping::decode_muscle_frames(context.input_bytes("wrapped"),
+                                             "decompose_fibres: input 'wrapped'");
+    for (const atlas::Muscle* muscle : muscles) {
+      if (wrapped.find_muscle(muscle->name) == nullptr) {
+        throw InvalidInputError("decompose_fibres: input 'wrapped' has no muscle '" + muscle->name +
+                                "'; hint: wrap the same muscles, or choose them with 'muscles'");
+      }
+    }
   }
-  BonePoses poses(atlas, atlas_dir);
+  const std::vector<double>& times = wrapped.times;
 
   const std::filesystem::path folder = context.scratch_dir() / "fibres";
   std::filesystem::remove_all(folder);
@@ -252,27 +191,25 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
     out.method = found != overrides.end() ? found->second : default_method;
     fibres::DecompositionOptions muscle_options = options;
     muscle_options.architecture = muscle.architecture;
+    const wrapping::FramedMuscle* framed = wrapped.find_muscle(muscle.name);
     const fibres::MuscleFibreModel model(
-        muscle.name, wrapping::wrapping_surface(muscle, atlas_dir, context.integer("target_faces")),
+        muscle.name,
+        framed != nullptr
+            ? framed->rest
+            : wrapping::wrapping_surface(muscle, atlas_dir, context.integer("target_faces")),
         fibres::attachment_samples(muscle, bone_surface), out.method, muscle_options);
     out.rest = model.decompose_at_rest();
     out.quality = fibres::measure_fibre_quality(
         model.rest(), out.rest.fibres, out.rest.attachments.origin, out.rest.attachments.insertion);
     if (&muscle == pictured) out.rest_surface = model.rest();
-    for (std::size_t k = 0; k < frames.size(); ++k) {
-      const AnimationFrame& frame = frames[k];
-      const auto part = frame.parts.find(muscle.name);
-      if (part == frame.parts.end()) {
-        throw InvalidInputError("decompose_fibres: the animation has no muscle '" + muscle.name +
-                                "' at time " + fixed(frame.time, 4) +
-                                "; hint: wrap the same muscles");
-      }
-      const mesh::IndexedMesh wrapped = mesh::read_vtp(part->second);
+    for (std::size_t k = 0; k < times.size(); ++k) {
+      mesh::IndexedMesh surface = model.rest();
+      surface.V = framed->positions[k].cast<double>();
       fibres::MuscleFibres result = model.decompose(
-          wrapped.V, [&](const std::string& bone) { return poses.pose(bone, k, frame); });
+          surface.V, [&](const std::string& bone) { return wrapped.pose(bone, k); });
       out.frame_seconds += result.seconds;
       out.frames_inside =
-          std::min(out.frames_inside, fibres::inside_fraction(wrapped, result.fibres));
+          std::min(out.frames_inside, fibres::inside_fraction(surface, result.fibres));
       out.frames.push_back(std::move(result.fibres));
     }
     out.field_seconds = model.field_seconds();
@@ -299,11 +236,11 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
                fixed(fibres::fibre_length(fibres[f]), 3) + "\n";
       }
     };
-    if (frames.empty()) {
+    if (times.empty()) {
       add_frame(result.rest.fibres, 0, 0.0);
     } else {
-      for (std::size_t k = 0; k < frames.size(); ++k) {
-        add_frame(result.frames[k], static_cast<int>(k), frames[k].time);
+      for (std::size_t k = 0; k < times.size(); ++k) {
+        add_frame(result.frames[k], static_cast<int>(k), times[k]);
       }
     }
     result.frames.clear();
@@ -314,7 +251,7 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
     row["moved_inside"] = result.rest.moved_inside;
     row["rest_ms"] = 1000.0 * result.rest.seconds;
     row["field_ms"] = 1000.0 * result.field_seconds;
-    row["frames"] = frames.size();
+    row["frames"] = times.size();
     row["frames_ms"] = 1000.0 * result.frame_seconds;
     row["frames_min_inside_fraction"] = result.frames_inside;
     worst_inside = std::min(worst_inside, result.frames_inside);
@@ -338,7 +275,8 @@ void DecomposeFibres::run(workflow::NodeContext& context) {
       "report",
       nlohmann::json{
           {"muscles", rows},
-          {"frames", frames.size()},
+          {"frames", times.size()},
+          {"wrapping_pathway", wrapped.pathway},
           {"fibres", options.fibres},
           {"segments", options.segments},
           {"min_inside_fraction", worst_inside},

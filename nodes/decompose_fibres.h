@@ -6,8 +6,10 @@
 // the harmonic field is computed once per muscle).
 //
 //   input  atlas      Atlas   the (scaled) atlas
-//   input  animation  File    optional: wrap_muscles's animation bundle (same
-//                             target_faces); its frames are decomposed
+//   input  wrapped    MuscleFrames  optional: a wrapping node's wrapped motion
+//                             (either pathway); each muscle is decomposed on its
+//                             rest surface there, then in every stored frame with
+//                             the attachments carried by the stored bone poses
 //   output fibres     File    folder bundle: fibres.pvd + one .vtp of polylines per
 //                             muscle and frame (ParaView plays them over the walk)
 //   output lengths    File    CSV: muscle, method, fibre, frame, time, length (mm)

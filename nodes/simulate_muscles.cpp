@@ -193,7 +193,7 @@ workflow::NodeSpec SimulateMuscles::spec() {
   using workflow::port::Report;
   const volumetric::MuscleSimulationOptions d;
   workflow::NodeSpec spec =
-      workflow::NodeSpec{"simulate_muscles", 1,
+      workflow::NodeSpec{"simulate_muscles", 2,
                          "Muscle wrapping over a fused motion (volumetric pathway): every muscle "
                          "in one conforming tetrahedral model, touching muscles sharing their "
                          "interface, moved by the bones frame by frame (projective dynamics), "
@@ -275,7 +275,7 @@ void SimulateMuscles::run(workflow::NodeContext& context) {
                fixed(report["max_depth_in_other_muscles_mm"].get<double>(), 2) + " mm");
   context.progress(2, 3, "writing the outputs");
   set_wrapping_outputs(context, simulated.motion, atlas, atlas_dir,
-                       "Muscle wrapping over the trial (volumetric pathway)");
+                       "Muscle wrapping over the trial (volumetric pathway)", "volumetric");
   report["node_seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   context.set_output("report", report.dump(2));

@@ -144,7 +144,7 @@ workflow::NodeSpec WrapMuscles::spec() {
   using workflow::port::Report;
   const wrapping::MuscleWrappingOptions d;
   workflow::NodeSpec spec =
-      workflow::NodeSpec{"wrap_muscles", 6,
+      workflow::NodeSpec{"wrap_muscles", 7,
                          "Muscle wrapping over a fused motion (energy pathway): per frame, "
                          "action lines re-routed on the "
                          "moving skeleton; each muscle surface deformed around them with its "
@@ -267,7 +267,7 @@ void WrapMuscles::run(workflow::NodeContext& context) {
                fixed(report["max_depth_mm"].get<double>(), 2) + " mm");
   context.progress(2, 3, "writing the outputs");
   set_wrapping_outputs(context, wrapped, atlas, atlas_dir,
-                       "Muscle wrapping over the trial (energy pathway)");
+                       "Muscle wrapping over the trial (energy pathway)", "energy");
   report["node_seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   context.set_output("report", report.dump(2));

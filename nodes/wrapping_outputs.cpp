@@ -12,6 +12,7 @@
 #include "core/mesh/io/mesh_io.h"
 #include "core/mesh/io/vtp_series.h"
 #include "core/motion/motion_io.h"
+#include "core/wrapping/muscle_frames.h"
 #include "core/wrapping/wrapping_summary.h"
 #include "nodes/number_text.h"
 
@@ -153,13 +154,16 @@ motion::FusedMotion atlas_motion_input(const workflow::NodeContext& context,
 workflow::NodeSpec& add_wrapping_outputs(workflow::NodeSpec& spec) {
   using workflow::port::File;
   return spec
-      .param<std::int64_t>(
-          "animation_stride", 5,
-          "The animation holds every n-th frame (ASCII .vtp: every frame of 21 muscles "
-          "over a 2 s walk is ~1.8 GB)",
-          {.min = 1, .max = 1000})
+      .param<std::int64_t>("animation_stride", 5,
+                           "The animation and the wrapped motion hold every n-th frame (ASCII "
+                           ".vtp: every frame of 38 muscles over a 2 s walk is several GB)",
+                           {.min = 1, .max = 1000})
       .param<std::string>("bone_level", "lod2",
                           "Atlas mesh level of the bones drawn in the animation")
+      .output<workflow::port::MuscleFrames>(
+          "wrapped",
+          "The wrapped motion, binary: bone poses and every muscle's rest surface, surface and "
+          "action lines per stored frame (decompose_fibres reads it)")
       .output<File>("animation",
                     "Folder bundle of a ParaView animation (wrapping.pvd + .vtp per frame)")
       .output<File>(
@@ -171,13 +175,15 @@ workflow::NodeSpec& add_wrapping_outputs(workflow::NodeSpec& spec) {
 
 void set_wrapping_outputs(workflow::NodeContext& context, const wrapping::MuscleWrapping& wrapped,
                           const atlas::Atlas& atlas, const std::filesystem::path& atlas_dir,
-                          const std::string& plot_title) {
+                          const std::string& plot_title, const std::string& pathway) {
   context.set_output("metrics", metrics_csv(wrapped));
   context.set_output("lines", lines_csv(wrapped));
   context.set_output("plot", wrapping::wrapping_metrics_svg(wrapped, plot_title));
+  const int stride = static_cast<int>(context.integer("animation_stride"));
   context.set_output(
-      "animation", animation_bundle(context, wrapped, atlas, atlas_dir, context.text("bone_level"),
-                                    static_cast<int>(context.integer("animation_stride"))));
+      "wrapped", wrapping::encode_muscle_frames(wrapping::muscle_frames(wrapped, stride, pathway)));
+  context.set_output("animation", animation_bundle(context, wrapped, atlas, atlas_dir,
+                                                   context.text("bone_level"), stride));
 }
 
 }  // namespace mmm::nodes

@@ -22,15 +22,16 @@ motion::FusedMotion atlas_motion_input(const workflow::NodeContext& context,
                                        const std::string& node);
 
 // Declares the parameters 'animation_stride' and 'bone_level' and the
-// outputs 'animation', 'metrics', 'lines' and 'plot' that
+// outputs 'wrapped', 'animation', 'metrics', 'lines' and 'plot' that
 // set_wrapping_outputs fills.
 workflow::NodeSpec& add_wrapping_outputs(workflow::NodeSpec& spec);
 
-// Sets the outputs 'metrics', 'lines', 'plot' (titled `plot_title`) and
+// Sets the outputs 'metrics', 'lines', 'plot' (titled `plot_title`),
+// 'wrapped' (core/wrapping/muscle_frames.h, written by `pathway`) and
 // 'animation' (parameters 'bone_level' and 'animation_stride').
 void set_wrapping_outputs(workflow::NodeContext& context, const wrapping::MuscleWrapping& wrapped,
                           const atlas::Atlas& atlas, const std::filesystem::path& atlas_dir,
-                          const std::string& plot_title);
+                          const std::string& plot_title, const std::string& pathway);
 
 // One row per muscle and frame: volume error, bone and muscle penetration,
 // contacts, smoothness, time.

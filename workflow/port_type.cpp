@@ -24,7 +24,9 @@ constexpr std::array<PortTypeInfo, 15> kPortTypes = {{
     {PortType::kMarkerTrajectories, "MarkerTrajectories",
      "Motion-capture marker positions per frame (TRC content)", ".trc"},
     {PortType::kBonePoses, "BonePoses", "Rigid pose of every bone per frame", ".json"},
-    {PortType::kMuscleFrames, "MuscleFrames", "Deformed muscle surfaces and action lines per frame",
+    {PortType::kMuscleFrames, "MuscleFrames",
+     "A wrapped motion, binary: bone poses, each muscle's rest surface, its surface and action "
+     "lines per stored frame",
      ".frames"},
     {PortType::kFibreSet, "FibreSet", "Muscle fibres as polylines (mm)", ".json"},
     {PortType::kOutlineCorrections, "OutlineCorrections",

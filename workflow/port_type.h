@@ -27,7 +27,8 @@ enum class PortType {
   kRadiographPair,      // two calibrated X-ray views: images + 3x4 projection matrices
   kMarkerTrajectories,  // motion-capture markers over time (TRC content)
   kBonePoses,           // per-frame rigid pose of every bone
-  kMuscleFrames,        // per-frame deformed muscle surfaces and action lines
+  kMuscleFrames,        // a wrapped motion: bone poses, muscle surfaces and action lines per
+                        // stored frame, binary (core/wrapping/muscle_frames.h)
   kFibreSet,            // muscle fibres as polylines
   kOutlineCorrections,  // an operator's verdict on projected bone outlines, JSON
                         // (core/image/outline_corrections.h)

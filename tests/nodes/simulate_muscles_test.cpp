@@ -15,6 +15,7 @@
 #include "core/errors.h"
 #include "core/mesh/io/pvd.h"
 #include "nodes/build_muscle_lattice.h"
+#include "nodes/decompose_fibres.h"
 #include "tests/nodes/node_harness.h"
 #include "tests/nodes/toy_walk.h"
 #include "tests/support/test_data.h"
@@ -59,6 +60,17 @@ TEST(SimulateMusclesNodeTest, TouchingMusclesKeepVolumeStayApartAndOutOfTheBones
   }
   // The energy pathway's outputs.
   test::expect_wrapping_outputs(harness, outputs, frames, 2, "vastus_b_r", 2);
+  // decompose_fibres reads the simulated motion as it reads the energy
+  // pathway's: the fibres stay inside the simulated surfaces in every frame.
+  const auto fibres =
+      harness.run<DecomposeFibres>({{"atlas", toy.atlas}, {"wrapped", outputs.at("wrapped")}},
+                                   {{"fibres", std::int64_t{16}}, {"segments", std::int64_t{8}}});
+  const nlohmann::json fibre_report = report_of(fibres);
+  EXPECT_EQ(fibre_report["frames"], (frames + 1) / 2);
+  EXPECT_EQ(fibre_report["wrapping_pathway"], "volumetric");
+  for (const nlohmann::json& muscle : fibre_report["muscles"]) {
+    EXPECT_GE(muscle["frames_min_inside_fraction"].get<double>(), 0.98) << muscle["muscle"];
+  }
 }
 
 // Without a stored lattice the node builds one; one thread or two, the

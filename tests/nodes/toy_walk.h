@@ -16,6 +16,8 @@
 #include "core/atlas/atlas_io.h"
 #include "core/directory_bundle.h"
 #include "core/mesh/io/pvd.h"
+#include "core/mesh/io/vtp.h"
+#include "core/wrapping/muscle_frames.h"
 #include "nodes/fuse_motion.h"
 #include "tests/support/test_data.h"
 
@@ -128,6 +130,19 @@ inline void expect_wrapping_outputs(NodeHarness& harness,
   EXPECT_EQ(muscle_frames, (frames + stride - 1) / stride);
   EXPECT_TRUE(std::filesystem::exists(animation / "wrapping" / "action_lines_0000.vtp"));
   EXPECT_TRUE(std::filesystem::exists(animation / "wrapping" / "femur_r_0000.vtp"));
+  // The wrapped motion holds the animation's frames: the same muscle surfaces
+  // (vertex for vertex) and the bones' poses.
+  const wrapping::MuscleFrames wrapped = wrapping::decode_muscle_frames(
+      mmm::test::read_text(outputs.at("wrapped").path), "output 'wrapped'");
+  EXPECT_EQ(wrapped.motion_frames, frames);
+  ASSERT_EQ(static_cast<long>(wrapped.times.size()), muscle_frames);
+  EXPECT_EQ(static_cast<long>(wrapped.muscles.size()), muscles);
+  const wrapping::FramedMuscle* framed = wrapped.find_muscle(muscle);
+  ASSERT_NE(framed, nullptr);
+  const mesh::IndexedMesh drawn = mesh::read_vtp(animation / "wrapping" / (muscle + "_0001.vtp"));
+  ASSERT_EQ(drawn.V.rows(), framed->rest.V.rows());
+  EXPECT_LT((drawn.V - framed->positions[1].cast<double>()).cwiseAbs().maxCoeff(), 1e-2);
+  EXPECT_EQ(wrapped.pose("femur_r", 0).matrix().rows(), 4);
 }
 
 }  // namespace mmm::nodes::test

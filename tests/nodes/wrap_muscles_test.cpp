@@ -16,6 +16,7 @@
 #include "core/directory_bundle.h"
 #include "core/errors.h"
 #include "core/mesh/io/pvd.h"
+#include "core/wrapping/muscle_frames.h"
 #include "nodes/build_hulls.h"
 #include "nodes/decompose_fibres.h"
 #include "nodes/fuse_motion.h"
@@ -60,7 +61,7 @@ TEST(DecomposeFibresNodeTest, FibresFollowTheWrappedMuscleFrameByFrame) {
   const auto wrapped = harness.run<WrapMuscles>({{"atlas", toy.atlas}, {"motion", toy.motion}},
                                                 {{"animation_stride", std::int64_t{6}}});
   const auto outputs =
-      harness.run<DecomposeFibres>({{"atlas", toy.atlas}, {"animation", wrapped.at("animation")}},
+      harness.run<DecomposeFibres>({{"atlas", toy.atlas}, {"wrapped", wrapped.at("wrapped")}},
                                    {{"fibres", std::int64_t{16}}, {"segments", std::int64_t{10}}});
   const nlohmann::json report =
       nlohmann::json::parse(mmm::test::read_text(outputs.at("report").path));
@@ -108,6 +109,22 @@ TEST(DecomposeFibresNodeTest, FibresFollowTheWrappedMuscleFrameByFrame) {
   EXPECT_THROW((void)harness.run<DecomposeFibres>({{"atlas", toy.atlas}},
                                                   {{"muscles", std::string("nobody")}}),
                InvalidInputError);
+  // A wrapped motion that is not one, or lacks a muscle to decompose, is
+  // refused naming the input.
+  const auto refused = [&](const std::string& bytes, const std::string& expected) {
+    try {
+      (void)harness.run<DecomposeFibres>(
+          {{"atlas", toy.atlas}, {"wrapped", harness.add(PortType::kMuscleFrames, bytes)}});
+      ADD_FAILURE() << "accepted; expected " << expected;
+    } catch (const InvalidInputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused("wrapping.pvd", "input 'wrapped': header");
+  wrapping::MuscleFrames none =
+      wrapping::decode_muscle_frames(mmm::test::read_text(wrapped.at("wrapped").path), "wrapped");
+  none.muscles.clear();
+  refused(wrapping::encode_muscle_frames(none), "has no muscle");
 }
 
 // Muscles are decomposed in parallel and written in muscle order: the
@@ -120,7 +137,7 @@ TEST(DecomposeFibresNodeTest, TheOutputsDoNotDependOnTheNumberOfThreads) {
                                                 {{"animation_stride", std::int64_t{6}}});
   const auto decompose = [&](std::int64_t threads) {
     return harness.run<DecomposeFibres>(
-        {{"atlas", toy.atlas}, {"animation", wrapped.at("animation")}},
+        {{"atlas", toy.atlas}, {"wrapped", wrapped.at("wrapped")}},
         {{"fibres", std::int64_t{16}}, {"segments", std::int64_t{8}}, {"threads", threads}});
   };
   const auto one = decompose(1);
