@@ -56,10 +56,9 @@ namespace {
 constexpr int kArtifactStride = 5;
 
 double wrapped_motion_mb(const mmm::wrapping::MuscleWrapping& wrapped) {
-  return static_cast<double>(
-             mmm::wrapping::encode_muscle_frames(
-                 mmm::wrapping::muscle_frames(wrapped, kArtifactStride, "bench"))
-                 .size()) /
+  return static_cast<double>(mmm::wrapping::encode_muscle_frames(
+                                 mmm::wrapping::muscle_frames(wrapped, kArtifactStride, "bench"))
+                                 .size()) /
          1e6;
 }
 
@@ -414,6 +413,14 @@ nlohmann::json write_volumetric_table(std::ostringstream& out) {
         options.simulation.volume_weight >> comma >> options.simulation.contact_weight >> comma >>
         options.attachment_reach_mm;
   }
+  // MMM_BENCH_VOLUMETRIC_INTERFACES=shared|stick|slide, and
+  // MMM_BENCH_VOLUMETRIC_INTERFACE_WEIGHT for the ties of the last two.
+  if (const char* interfaces = std::getenv("MMM_BENCH_VOLUMETRIC_INTERFACES")) {
+    options.interfaces = volumetric::interfaces_from_name(interfaces)
+                             .value_or(volumetric::MuscleInterfaces::kShared);
+  }
+  if (const char* weight = std::getenv("MMM_BENCH_VOLUMETRIC_INTERFACE_WEIGHT"))
+    options.simulation.interface_weight = std::stod(weight);
   // MMM_BENCH_VOLUMETRIC_FRAMES: only the first n frames.
   motion::FusedMotion walk_frames = atlas_walk();
   if (const char* frames = std::getenv("MMM_BENCH_VOLUMETRIC_FRAMES"); frames != nullptr) {
@@ -458,7 +465,10 @@ nlohmann::json write_volumetric_table(std::ostringstream& out) {
       << " surface nodes moved out of bones by up to " << simulated.rest_moved_out_of_bones_mm
       << " mm, " << simulated.rest_inverted_output << " fine tetrahedra inverted by it), "
       << options.simulation.iterations << " rounds per frame, " << simulated.motion.threads
-      << " threads\n"
+      << " threads; interfaces " << volumetric::interfaces_name(options.interfaces) << " ("
+      << simulated.interface_pairs << " tied pairs; at worst " << std::setprecision(2)
+      << simulated.max_interface_gap_mm << " mm across, " << simulated.max_interface_slide_mm
+      << " mm along)\n"
       << "  worst volume error " << std::scientific << std::setprecision(1)
       << walk.max_volume_percent << " %, deepest in bone " << std::fixed << std::setprecision(2)
       << walk.max_depth_mm << " mm, in other muscles median / p99 / max "
@@ -537,6 +547,10 @@ nlohmann::json write_volumetric_table(std::ostringstream& out) {
           {"spacing_mm", simulated.spacing_mm},
           {"coarsening", simulated.coarsening},
           {"rounds", options.simulation.iterations},
+          {"interfaces", std::string(volumetric::interfaces_name(options.interfaces))},
+          {"interface_pairs", simulated.interface_pairs},
+          {"max_interface_gap_mm", simulated.max_interface_gap_mm},
+          {"max_interface_slide_mm", simulated.max_interface_slide_mm},
           {"element_nodes", simulated.element_nodes},
           {"elements", simulated.elements},
           {"output_nodes", simulated.output_nodes},

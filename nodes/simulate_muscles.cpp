@@ -83,6 +83,12 @@ volumetric::MuscleSimulationOptions options_from(const workflow::NodeContext& co
   volumetric::MuscleSimulationOptions options;
   options.lattice.spacing_mm = context.number("spacing_mm");
   options.coarsening = static_cast<int>(context.integer("coarsening"));
+  const auto interfaces = volumetric::interfaces_from_name(context.text("interfaces"));
+  if (!interfaces) {
+    throw InvalidInputError("simulate_muscles: parameter 'interfaces' is '" +
+                            context.text("interfaces") + "'; hint: shared, stick or slide");
+  }
+  options.interfaces = *interfaces;
   options.simulation.iterations = static_cast<int>(context.integer("rounds"));
   options.attachment_reach_mm = context.number("attachment_reach_mm");
   options.anchor_joint_clearance_mm = context.number("joint_clearance_mm");
@@ -144,6 +150,10 @@ nlohmann::json report_of(const volumetric::MuscleSimulation& simulated,
       {"model",
        {{"spacing_mm", simulated.spacing_mm},
         {"coarsening", simulated.coarsening},
+        {"interfaces", std::string(volumetric::interfaces_name(options.interfaces))},
+        {"interface_pairs", simulated.interface_pairs},
+        {"max_interface_gap_mm", simulated.max_interface_gap_mm},
+        {"max_interface_slide_mm", simulated.max_interface_slide_mm},
         {"element_nodes", simulated.element_nodes},
         {"elements", simulated.elements},
         {"output_nodes", simulated.output_nodes},
@@ -214,6 +224,10 @@ workflow::NodeSpec SimulateMuscles::spec() {
               "Simulated elements are this many lattice cells across; the surfaces "
               "keep the lattice's detail (1: every cell simulated)",
               {.min = 1, .max = 8})
+          .param_enum("interfaces", "shared", {"shared", "stick", "slide"},
+                      "Touching muscles: one body sharing its interface nodes (shared), or "
+                      "separate bodies whose interface nodes are tied (stick) or may slide "
+                      "along each other (slide)")
           .param<std::int64_t>("rounds", d.simulation.iterations, "Local-global rounds per frame",
                                {.min = 1, .max = 100})
           .param<double>(

@@ -30,6 +30,13 @@ namespace mmm::volumetric {
 
 using EmbeddingWeights = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
+// Two output nodes of different muscles that are one point of their shared
+// interface at rest (embed_muscles_separately).
+struct InterfacePair {
+  int a = 0;
+  int b = 0;
+};
+
 struct EmbeddedModel {
   TetMesh elements;          // simulated (coarse)
   TetMesh output;            // its muscles' boundaries are the outputs (fine)
@@ -37,12 +44,24 @@ struct EmbeddedModel {
   // Per output node, the four element nodes of the element holding it.
   Eigen::Matrix<int, Eigen::Dynamic, 4, Eigen::RowMajor> host;
   int factor = 1;
+  // Separate muscles only: the pairs of output nodes that were one node.
+  std::vector<InterfacePair> interfaces;
 };
 
 // `factor` >= 1 (1: the elements are the fine tetrahedra themselves).
 // Throws InvalidInputError for a factor below 1 or a lattice without a
 // muscle cell.
 EmbeddedModel embed_in_coarse_lattice(const LabelledLattice& fine, int factor);
+
+// Every muscle a body of its own: the fine model's nodes on an interface
+// between muscles are split, one copy per muscle (`interfaces` pairs each
+// further copy with the first), and every muscle is embedded in coarse
+// elements of its own (a coarse cell holding fine cells of k muscles becomes
+// k elements, one per muscle, on k copies of its corners; "virtual nodes").
+// No element or node is shared between muscles, so interfaces can slide; the
+// simulation ties the pairs (tet_simulation.h). Same weights within a muscle
+// as embed_in_coarse_lattice. Throws as embed_in_coarse_lattice.
+EmbeddedModel embed_muscles_separately(const LabelledLattice& fine, int factor);
 
 // The identity embedding: the elements are the output.
 EmbeddedModel embed_identity(TetMesh mesh);

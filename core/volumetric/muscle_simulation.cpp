@@ -71,6 +71,30 @@ double bending(const Eigen::SparseMatrix<double>& laplacian, const Eigen::Matrix
   return (laplacian * x).squaredNorm();
 }
 
+}  // namespace
+
+std::string_view interfaces_name(MuscleInterfaces interfaces) {
+  switch (interfaces) {
+    case MuscleInterfaces::kShared:
+      return "shared";
+    case MuscleInterfaces::kStick:
+      return "stick";
+    case MuscleInterfaces::kSlide:
+      return "slide";
+  }
+  return "shared";
+}
+
+std::optional<MuscleInterfaces> interfaces_from_name(std::string_view name) {
+  for (const MuscleInterfaces i :
+       {MuscleInterfaces::kShared, MuscleInterfaces::kStick, MuscleInterfaces::kSlide}) {
+    if (interfaces_name(i) == name) return i;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
 void check_options(const MuscleSimulationOptions& options) {
   if (options.coarsening < 1 || options.coarsening > 8) {
     throw InvalidInputError("muscle simulation: coarsening must be 1-8, got " +
@@ -182,7 +206,10 @@ MuscleSimulation simulate_muscles(const atlas::Atlas& atlas, const std::filesyst
   result.lattice = labels.muscles;
   result.spacing_mm = labels.spacing_mm;
   result.coarsening = options.coarsening;
-  EmbeddedModel model = embed_in_coarse_lattice(labels, options.coarsening);
+  EmbeddedModel model = options.interfaces == MuscleInterfaces::kShared
+                            ? embed_in_coarse_lattice(labels, options.coarsening)
+                            : embed_muscles_separately(labels, options.coarsening);
+  result.interface_pairs = model.interfaces.size();
 
   std::vector<MuscleSurface> surfaces;
   const std::vector<DrivenNode> driven =
@@ -196,6 +223,7 @@ MuscleSimulation simulate_muscles(const atlas::Atlas& atlas, const std::filesyst
     bone_meshes.push_back(&bone.surface->tree().mesh());
   SimulationOptions simulation_options = options.simulation;
   simulation_options.threads = threads;
+  simulation_options.slide = options.interfaces == MuscleInterfaces::kSlide;
   TetSimulation simulation(std::move(model), driven, bone_meshes, simulation_options);
   result.checked_nodes = simulation.checked_nodes();
 
@@ -265,6 +293,9 @@ MuscleSimulation simulate_muscles(const atlas::Atlas& atlas, const std::filesyst
     const FrameStats stats = simulation.step(poses);
     result.simulation_seconds += seconds_since(since);
     result.max_inverted = std::max(result.max_inverted, stats.inverted);
+    result.max_interface_gap_mm = std::max(result.max_interface_gap_mm, stats.max_interface_gap_mm);
+    result.max_interface_slide_mm =
+        std::max(result.max_interface_slide_mm, stats.max_interface_slide_mm);
     const Eigen::MatrixX3d& y = simulation.positions();
 
     since = Clock::now();

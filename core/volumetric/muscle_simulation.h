@@ -23,7 +23,9 @@
 // first_frame_intermediate_poses steps at coordinates in between.
 
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/atlas/atlas.h"
@@ -35,9 +37,18 @@
 
 namespace mmm::volumetric {
 
+// How touching muscles meet: one body sharing its interface nodes, or
+// separate bodies (coarse_embedding.h, embed_muscles_separately) whose
+// interface nodes are tied in pairs, stuck or sliding (tet_simulation.h).
+enum class MuscleInterfaces { kShared, kStick, kSlide };
+std::string_view interfaces_name(MuscleInterfaces interfaces);
+// std::nullopt for a name other than shared, stick, slide.
+std::optional<MuscleInterfaces> interfaces_from_name(std::string_view name);
+
 struct MuscleSimulationOptions {
   LatticeOptions lattice;  // when no lattice is given
   int coarsening = 2;      // element cell = coarsening x lattice cell
+  MuscleInterfaces interfaces = MuscleInterfaces::kShared;
   double attachment_reach_mm = 4.0;
   // At rest, muscle surface nodes inside a bone or nearer than this are moved
   // out onto the bone's surface plus this.
@@ -68,6 +79,9 @@ struct MuscleSimulation {
   Eigen::Index element_nodes = 0;
   Eigen::Index elements = 0;
   Eigen::Index output_nodes = 0;
+  std::size_t interface_pairs = 0;      // separate muscles: tied node pairs
+  double max_interface_gap_mm = 0.0;    // across an interface, worst frame
+  double max_interface_slide_mm = 0.0;  // along it
   int checked_nodes = 0;
   int driven_nodes = 0;                     // attachment nodes
   int anchored_element_nodes = 0;           // element nodes inside a bone at rest, following it

@@ -60,9 +60,11 @@ void project(const Matrix3d& f, Eigen::Quaterniond& q, int iterations, Matrix3d&
 // Per node, the bones whose driven nodes it is connected to, weighted by
 // 1 / (d + h)^2 with d its distance along the mesh's edges to the nearest
 // of them (Dijkstra from all of a bone's driven nodes at once) and h the
-// mean edge length; normalised to sum 1.
+// mean edge length; normalised to sum 1. `links`: more edges (separate
+// muscles: the element nodes of the two sides of an interface pair).
 std::vector<std::vector<std::pair<int, double>>> blend_weights(
-    const TetMesh& mesh, const std::vector<DrivenNode>& driven, int bones) {
+    const TetMesh& mesh, const std::vector<DrivenNode>& driven, int bones,
+    const std::vector<std::pair<int, int>>& links) {
   const auto n = static_cast<std::size_t>(mesh.V.rows());
   std::vector<std::vector<int>> neighbours(n);
   double total = 0.0;
@@ -76,6 +78,10 @@ std::vector<std::vector<std::pair<int, double>>> blend_weights(
         ++count;
       }
     }
+  }
+  for (const auto& [a, b] : links) {
+    neighbours[static_cast<std::size_t>(a)].push_back(b);
+    neighbours[static_cast<std::size_t>(b)].push_back(a);
   }
   for (std::vector<int>& list : neighbours) {
     std::ranges::sort(list);
@@ -137,6 +143,21 @@ void add_point_term(const EmbeddingWeights& weights, int output_node, double w,
   }
 }
 
+// The triplets of w |W_a x - W_b x|^2 for two output nodes.
+void add_difference_term(const EmbeddingWeights& weights, int a, int b, double w,
+                         std::vector<Eigen::Triplet<double>>& triplets) {
+  for (const auto& [first, first_sign] : {std::pair{a, 1.0}, std::pair{b, -1.0}}) {
+    for (const auto& [second, second_sign] : {std::pair{a, 1.0}, std::pair{b, -1.0}}) {
+      for (EmbeddingWeights::InnerIterator i(weights, first); i; ++i) {
+        for (EmbeddingWeights::InnerIterator j(weights, second); j; ++j) {
+          triplets.emplace_back(static_cast<int>(i.col()), static_cast<int>(j.col()),
+                                w * first_sign * second_sign * i.value() * j.value());
+        }
+      }
+    }
+  }
+}
+
 // rhs += w W_i^T target.
 void add_point_rhs(const EmbeddingWeights& weights, int output_node, double w,
                    const Vector3d& target, Eigen::MatrixX3d& rhs) {
@@ -169,6 +190,10 @@ struct TetSimulation::State {
   Eigen::VectorXd mass;                        // per element node: its share of the volume
   std::vector<double> label_volume;            // per label, of its output boundary at rest
   std::vector<Contact> contacts;
+  // Separate muscles: the tied pairs, and per pair the faces of a's muscle
+  // surface around a (its normal for sliding).
+  std::vector<InterfacePair> interfaces;
+  std::vector<std::vector<Eigen::Vector3i>> interface_faces;
   scaling::SparseCholesky solver;
   Eigen::MatrixX3d x;  // element nodes
   Eigen::MatrixX3d y;  // output nodes, W x
@@ -332,6 +357,44 @@ TetSimulation::TetSimulation(EmbeddedModel model, std::vector<DrivenNode> driven
   }
   for (const State::Contact& c : s.contacts)
     add_point_term(weights, c.node, options.contact_weight * s.scale, triplets);
+  if (!(options.interface_weight > 0) || !std::isfinite(options.interface_weight)) {
+    throw InvalidInputError("simulation interface_weight must be a positive number");
+  }
+  s.interfaces = s.model.interfaces;
+  {
+    std::vector<int> first_pair(static_cast<std::size_t>(outputs), -1);
+    std::vector<std::vector<int>> pairs_of(static_cast<std::size_t>(outputs));
+    for (std::size_t k = 0; k < s.interfaces.size(); ++k) {
+      const InterfacePair& pair = s.interfaces[k];
+      if (pair.a < 0 || pair.b < 0 || pair.a >= outputs || pair.b >= outputs || pair.a == pair.b) {
+        throw InvalidInputError("simulation: interface pair " + std::to_string(k) +
+                                " is out of range");
+      }
+      add_difference_term(weights, pair.a, pair.b, options.interface_weight * s.scale, triplets);
+      pairs_of[static_cast<std::size_t>(pair.a)].push_back(static_cast<int>(k));
+    }
+    // The interface's own faces: those with every corner on an interface
+    // (at the interface's rim a node's other faces would tilt its normal).
+    std::vector<char> paired(static_cast<std::size_t>(outputs), 0);
+    for (const InterfacePair& pair : s.interfaces) {
+      paired[static_cast<std::size_t>(pair.a)] = 1;
+      paired[static_cast<std::size_t>(pair.b)] = 1;
+    }
+    s.interface_faces.resize(s.interfaces.size());
+    for (const Eigen::MatrixX3i& faces : boundaries) {
+      for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+        if (paired[static_cast<std::size_t>(faces(f, 0))] == 0 ||
+            paired[static_cast<std::size_t>(faces(f, 1))] == 0 ||
+            paired[static_cast<std::size_t>(faces(f, 2))] == 0) {
+          continue;
+        }
+        for (int c = 0; c < 3; ++c) {
+          for (const int k : pairs_of[static_cast<std::size_t>(faces(f, c))])
+            s.interface_faces[static_cast<std::size_t>(k)].emplace_back(faces.row(f).transpose());
+        }
+      }
+    }
+  }
   Eigen::SparseMatrix<double> system(n, n);
   system.setFromTriplets(triplets.begin(), triplets.end());
   s.solver.compute(system);
@@ -371,7 +434,15 @@ TetSimulation::TetSimulation(EmbeddedModel model, std::vector<DrivenNode> driven
       fixed[static_cast<std::size_t>(it.col())] = 1;
     }
   }
-  s.blend = blend_weights(elements, seeds, static_cast<int>(s.bones.size()));
+  // Separate muscles: the warm start carries a muscle with nothing driven
+  // by its neighbours across their interfaces.
+  std::vector<std::pair<int, int>> links;
+  for (const InterfacePair& pair : s.interfaces) {
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        links.emplace_back(s.model.host(pair.a, i), s.model.host(pair.b, j));
+  }
+  s.blend = blend_weights(elements, seeds, static_cast<int>(s.bones.size()), links);
   s.label_volume = boundary_volumes(boundaries, s.y);
   s.volumes = std::make_unique<VolumeRestorer>(s.model.weights, std::move(boundaries),
                                                s.label_volume, std::move(fixed));
@@ -479,6 +550,21 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
     since = now;
     return elapsed;
   };
+  // Pair k's offset y_a - y_b split into its part across the interface
+  // (along a's surface normal) and its part along the interface.
+  const auto interface_offset = [&](std::size_t k) -> std::pair<double, Vector3d> {
+    const InterfacePair& pair = s.interfaces[k];
+    const Vector3d offset = (s.y.row(pair.a) - s.y.row(pair.b)).transpose();
+    Vector3d normal = Vector3d::Zero();
+    for (const Eigen::Vector3i& f : s.interface_faces[k]) {
+      const Vector3d p0 = s.y.row(f(0)).transpose();
+      normal += (s.y.row(f(1)).transpose() - p0).cross(s.y.row(f(2)).transpose() - p0);
+    }
+    if (normal.norm() < 1e-12) return {offset.norm(), Vector3d::Zero()};
+    normal.normalize();
+    const double across = normal.dot(offset);
+    return {across, offset - across * normal};
+  };
   s.y = weights * s.x;
   for (int iteration = 0; iteration < o.iterations; ++iteration) {
     StepClock::time_point since = StepClock::now();
@@ -512,6 +598,13 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
       add_point_rhs(weights, s.contacts[c].node, o.contact_weight * s.scale, contact_target[c],
                     rhs);
     }
+    if (o.slide) {
+      for (std::size_t k = 0; k < s.interfaces.size(); ++k) {
+        const Vector3d along = interface_offset(k).second;
+        add_point_rhs(weights, s.interfaces[k].a, o.interface_weight * s.scale, along, rhs);
+        add_point_rhs(weights, s.interfaces[k].b, -o.interface_weight * s.scale, along, rhs);
+      }
+    }
     s.x = s.solver.solve(rhs);
     s.y = weights * s.x;
     stats.solve_seconds += lap(since);
@@ -527,6 +620,11 @@ FrameStats TetSimulation::step(const std::vector<Eigen::Isometry3d>& poses) {
   for (const double d : depth) {
     stats.max_bone_depth_mm = std::max(stats.max_bone_depth_mm, d);
     stats.nodes_in_bones += d > 0 ? 1 : 0;
+  }
+  for (std::size_t k = 0; k < s.interfaces.size(); ++k) {
+    const auto [across, along] = interface_offset(k);
+    stats.max_interface_gap_mm = std::max(stats.max_interface_gap_mm, std::abs(across));
+    stats.max_interface_slide_mm = std::max(stats.max_interface_slide_mm, along.norm());
   }
   stats.inverted_per_label.assign(s.label_volume.size(), 0);
   for (Eigen::Index t = 0; t < tets; ++t) {

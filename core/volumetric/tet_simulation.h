@@ -57,8 +57,15 @@ struct SimulationOptions {
   double driven_weight = 1.0e4;    // against the tetrahedra's, per node
   double inertia_weight = 1.0e-3;  // against the tetrahedra's
   double contact_weight = 10.0;    // against the tetrahedra's, per checked node
-  int iterations = 10;             // local-global rounds per frame
-  int rotation_iterations = 2;     // polar-decomposition steps per element and round
+  // Separate muscles (EmbeddedModel::interfaces): each pair of interface
+  // nodes is tied by w_i |y_a - y_b - p|^2. Stick: p = 0. Slide: p is the
+  // part of y_a - y_b along the interface (the plane normal to a's muscle
+  // surface at a), so the muscles slide along each other but neither part
+  // nor enter each other there.
+  bool slide = false;
+  double interface_weight = 1000.0;  // against the tetrahedra's, per pair
+  int iterations = 10;               // local-global rounds per frame
+  int rotation_iterations = 2;       // polar-decomposition steps per element and round
   double bone_clearance_mm = 0.1;
   double contact_reach_mm = 15.0;  // nodes this close to a bone at rest are checked
   int threads = 1;
@@ -79,6 +86,10 @@ struct FrameStats {
   int inverted = 0;                     // elements with det F <= 0
   std::vector<int> inverted_per_label;  // per element label (index label - 1)
   std::vector<double> volume_change;    // per label (index label - 1): volume / rest - 1
+  // Separate muscles: the largest distance across the interface (normal to
+  // it at a) and along it (how far the sides slid) over the pairs.
+  double max_interface_gap_mm = 0.0;
+  double max_interface_slide_mm = 0.0;
   double seconds = 0.0;
   // Where the time went: local steps (projections), contact targets, the
   // global solves (right-hand sides and back-substitution), volume restoration.

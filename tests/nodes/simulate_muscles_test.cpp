@@ -96,6 +96,28 @@ TEST(SimulateMusclesNodeTest, TheSurfacesDoNotDependOnTheNumberOfThreads) {
   EXPECT_EQ(a, mmm::test::read_text(harness.folder() / "two" / "wrapping" / muscle));
 }
 
+// The touching vasti as separate bodies: their interface nodes are tied in
+// pairs; stuck, the pairs stay together; sliding, they stay on each other
+// across the interface. Both keep the volumes and stay out of the bones.
+TEST(SimulateMusclesNodeTest, SeparateMusclesStickOrSlideAsConfigured) {
+  test::NodeHarness harness;
+  const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.62, 3.0, true);
+  for (const std::string interfaces : {"stick", "slide"}) {
+    const nlohmann::json report = report_of(harness.run<SimulateMuscles>(
+        {{"atlas", toy.atlas}, {"motion", toy.motion}},
+        {{"spacing_mm", 2.0}, {"interfaces", interfaces}, {"threads", std::int64_t{2}}}));
+    EXPECT_EQ(report["model"]["interfaces"], interfaces);
+    EXPECT_GT(report["model"]["interface_pairs"].get<int>(), 50) << interfaces;
+    EXPECT_LT(report["model"]["max_interface_gap_mm"].get<double>(), 0.5) << interfaces;
+    EXPECT_LT(report["max_abs_volume_error_percent"].get<double>(), 1e-3) << interfaces;
+    EXPECT_LE(report["max_depth_mm"].get<double>(), 0.5) << interfaces;
+    EXPECT_EQ(report["max_inverted_elements"], 0) << interfaces;
+  }
+  EXPECT_THROW((void)harness.run<SimulateMuscles>({{"atlas", toy.atlas}, {"motion", toy.motion}},
+                                                  {{"interfaces", std::string("glued")}}),
+               InvalidInputError);
+}
+
 TEST(SimulateMusclesNodeTest, ABrokenLatticeIsRefusedNamingTheFile) {
   test::NodeHarness harness;
   const ToyLegAndWalk toy = toy_leg_and_walk(harness, 0.55);

@@ -69,6 +69,54 @@ TEST(CoarseEmbeddingTest, ARigidMotionOfTheElementsMovesTheOutputRigidly) {
   EXPECT_LT((model.weights * x - expected).cwiseAbs().maxCoeff(), 1e-9);
 }
 
+// Each muscle a body of its own: the interface nodes are split, one copy per
+// muscle, paired, at the same place at rest; no element or element node is
+// shared between the muscles (a coarse cell across the interface becomes one
+// element per muscle), and each copy is still an exact convex combination of
+// its own muscle's element.
+TEST(CoarseEmbeddingTest, SeparateMusclesShareNoNodeAndPairTheirInterface) {
+  const LabelledLattice fine = two_blocks(1.0);
+  Eigen::Index more = 0;  // elements added by separating, over the factors
+  for (const int factor : {1, 2, 3}) {
+    const EmbeddedModel shared = embed_in_coarse_lattice(fine, factor);
+    const EmbeddedModel model = embed_muscles_separately(fine, factor);
+    // The interface at x = 20 (15 x 12 nodes) is split once.
+    EXPECT_EQ(model.output.V.rows(), shared.output.V.rows() + 15 * 12);
+    ASSERT_EQ(model.interfaces.size(), 15U * 12U);
+    for (const InterfacePair& pair : model.interfaces) {
+      EXPECT_EQ(model.output.V.row(pair.a), model.output.V.row(pair.b));
+      EXPECT_DOUBLE_EQ(model.output.V(pair.a, 0), 20.0);
+    }
+    EXPECT_LT((model.weights * model.elements.V - model.output.V).cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_GE(model.weights.coeffs().minCoeff(), 0.0);
+    // Per element node, the labels of the elements using it: one each.
+    std::vector<std::uint16_t> owner(static_cast<std::size_t>(model.elements.V.rows()), 0);
+    for (Eigen::Index t = 0; t < model.elements.T.rows(); ++t) {
+      for (int a = 0; a < 4; ++a) {
+        std::uint16_t& o = owner[static_cast<std::size_t>(model.elements.T(t, a))];
+        const std::uint16_t label = model.elements.label[static_cast<std::size_t>(t)];
+        EXPECT_TRUE(o == 0 || o == label);
+        o = label;
+      }
+    }
+    // An output node's weights point at elements of its own muscle only.
+    std::vector<std::uint16_t> node_label(static_cast<std::size_t>(model.output.V.rows()), 0);
+    for (Eigen::Index t = 0; t < model.output.T.rows(); ++t)
+      for (int a = 0; a < 4; ++a)
+        node_label[static_cast<std::size_t>(model.output.T(t, a))] =
+            model.output.label[static_cast<std::size_t>(t)];
+    for (int row = 0; row < model.weights.outerSize(); ++row) {
+      for (EmbeddingWeights::InnerIterator it(model.weights, row); it; ++it)
+        EXPECT_EQ(owner[static_cast<std::size_t>(it.col())],
+                  node_label[static_cast<std::size_t>(row)]);
+    }
+    EXPECT_GE(model.elements.T.rows(), shared.elements.T.rows());
+    more += model.elements.T.rows() - shared.elements.T.rows();
+  }
+  EXPECT_GT(more, 0);  // some coarse cell across the interface, split in two
+  EXPECT_THROW(embed_muscles_separately(fine, 0), InvalidInputError);
+}
+
 TEST(CoarseEmbeddingTest, BadInputIsRefused) {
   EXPECT_THROW(embed_in_coarse_lattice(two_blocks(2.0), 0), InvalidInputError);
   LabelledLattice empty = two_blocks(2.0);
