@@ -42,7 +42,7 @@ FramedMuscle get_muscle(BinaryReader& in, std::size_t frames, std::size_t index)
   const std::string field = "muscle '" + muscle.name + "'";
   if (muscle.name.empty()) in.fail(where, "has no name");
   const std::uint32_t vertices = in.count(field + " vertices", 3 * sizeof(double));
-  const std::uint32_t faces = in.get<std::uint32_t>(field + " faces");
+  const auto faces = in.get<std::uint32_t>(field + " faces");
   in.need(faces, 3 * sizeof(std::uint32_t), field + " faces");
   in.need(static_cast<std::uint64_t>(frames) * vertices, 3 * sizeof(float), field + " positions");
   muscle.rest.V.resize(vertices, 3);
@@ -142,7 +142,7 @@ MuscleFrames decode_muscle_frames(std::string_view bytes, const std::string& wha
   }
   for (std::uint32_t k = 0; k < stored; ++k) {
     const auto index = in.get<std::uint32_t>("frame index");
-    const double time = in.finite<double>("frame time");
+    const auto time = in.finite<double>("frame time");
     if (index >= static_cast<std::uint32_t>(frames.motion_frames) ||
         (k > 0 &&
          (static_cast<int>(index) <= frames.frame_index.back() || time <= frames.times.back()))) {

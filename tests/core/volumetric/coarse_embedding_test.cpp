@@ -81,7 +81,7 @@ TEST(CoarseEmbeddingTest, SeparateMusclesShareNoNodeAndPairTheirInterface) {
     const EmbeddedModel shared = embed_in_coarse_lattice(fine, factor);
     const EmbeddedModel model = embed_muscles_separately(fine, factor);
     // The interface at x = 20 (15 x 12 nodes) is split once.
-    EXPECT_EQ(model.output.V.rows(), shared.output.V.rows() + 15 * 12);
+    EXPECT_EQ(model.output.V.rows(), shared.output.V.rows() + Eigen::Index{15} * 12);
     ASSERT_EQ(model.interfaces.size(), 15U * 12U);
     for (const InterfacePair& pair : model.interfaces) {
       EXPECT_EQ(model.output.V.row(pair.a), model.output.V.row(pair.b));

@@ -39,7 +39,7 @@ MuscleWrapping two_muscles_seven_frames() {
     poses[1].translation() = Eigen::Vector3d(1.0, -2.0, 0.5 * k);
     wrapped.bone_poses.push_back(poses);
     for (WrappedMuscle& muscle : wrapped.muscles) {
-      muscle.positions.push_back((muscle.rest.V.array() + 0.25 * k).matrix().cast<float>());
+      muscle.positions.emplace_back((muscle.rest.V.array() + 0.25 * k).matrix().cast<float>());
       std::vector<Eigen::Vector3d> path(static_cast<std::size_t>(2 + k % 3));
       for (std::size_t i = 0; i < path.size(); ++i)
         path[i] = Eigen::Vector3d(k, static_cast<double>(i), 1.5);
@@ -122,16 +122,17 @@ TEST(MuscleFramesTest, DamagedOrHostileBytesAreRefusedNamingTheField) {
   expect_refused(patched(good, stored_at + 4 + 4, std::numeric_limits<double>::quiet_NaN()),
                  "frame time");
   // The first bone pose's first rotation entry: not a rotation, then NaN.
-  const std::size_t bones_at = stored_at + 4 + 4 * 12;
+  const std::size_t bones_at = stored_at + 4 + std::size_t{4} * 12;
   const std::size_t poses_at = bones_at + 4 + (4 + 7) + (4 + 7);
   expect_refused(patched(good, poses_at, 2.0), "not a rotation");
   expect_refused(patched(good, poses_at, std::numeric_limits<double>::infinity()), "finite");
   // The first muscle: a vertex count beyond the bytes, then a face corner
   // beyond its vertices.
-  const std::size_t muscle_at = poses_at + 4 * 2 * 12 * 8 + 4;
+  const std::size_t muscle_at = poses_at + std::size_t{4} * 2 * 12 * 8 + 4;
   const std::size_t vertices_at = muscle_at + 4 + 8;  // "vastus_r"
   expect_refused(patched(good, vertices_at, std::uint32_t{2'000'000'000U}), "vertices");
-  const std::size_t faces_at = vertices_at + 8 + 12 * 3 * 8;  // an icosahedron's 12 vertices
+  const std::size_t faces_at =
+      vertices_at + 8 + std::size_t{12} * 3 * 8;  // an icosahedron's 12 vertices
   expect_refused(patched(good, faces_at, std::uint32_t{12}), "refers to vertex 12 of 12");
 }
 
