@@ -227,7 +227,8 @@ workflow::NodeSpec SimulateMuscles::spec() {
           .param_enum("interfaces", "shared", {"shared", "stick", "slide"},
                       "Touching muscles: one body sharing its interface nodes (shared), or "
                       "separate bodies whose interface nodes are tied (stick) or may slide "
-                      "along each other (slide)")
+                      "along each other (slide: pairs fixed at rest; over a walk they go "
+                      "stale, see docs/pipeline/volumetric.md)")
           .param<std::int64_t>("rounds", d.simulation.iterations, "Local-global rounds per frame",
                                {.min = 1, .max = 100})
           .param<double>(

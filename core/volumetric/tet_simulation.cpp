@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <numeric>
 #include <queue>
 #include <string>
 
@@ -434,10 +435,32 @@ TetSimulation::TetSimulation(EmbeddedModel model, std::vector<DrivenNode> driven
       fixed[static_cast<std::size_t>(it.col())] = 1;
     }
   }
-  // Separate muscles: the warm start carries a muscle with nothing driven
-  // by its neighbours across their interfaces.
+  // Separate muscles: the warm start carries a muscle across its
+  // interfaces by its neighbours' motion: every muscle when they stick, and
+  // when they slide only a muscle with nothing driven (the others follow
+  // their own bones and slide).
+  std::vector<int> part(static_cast<std::size_t>(n));
+  std::iota(part.begin(), part.end(), 0);
+  const auto root = [&](int i) {
+    while (part[static_cast<std::size_t>(i)] != i) {
+      part[static_cast<std::size_t>(i)] =
+          part[static_cast<std::size_t>(part[static_cast<std::size_t>(i)])];
+      i = part[static_cast<std::size_t>(i)];
+    }
+    return i;
+  };
+  for (Eigen::Index t = 0; t < tets; ++t) {
+    for (int a = 1; a < 4; ++a)
+      part[static_cast<std::size_t>(root(elements.T(t, a)))] = root(elements.T(t, 0));
+  }
+  std::vector<char> part_driven(static_cast<std::size_t>(n), 0);
+  for (const DrivenNode& seed : seeds) part_driven[static_cast<std::size_t>(root(seed.node))] = 1;
   std::vector<std::pair<int, int>> links;
   for (const InterfacePair& pair : s.interfaces) {
+    const bool link = !options.slide ||
+                      part_driven[static_cast<std::size_t>(root(s.model.host(pair.a, 0)))] == 0 ||
+                      part_driven[static_cast<std::size_t>(root(s.model.host(pair.b, 0)))] == 0;
+    if (!link) continue;
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j)
         links.emplace_back(s.model.host(pair.a, i), s.model.host(pair.b, j));

@@ -61,7 +61,9 @@ struct SimulationOptions {
   // nodes is tied by w_i |y_a - y_b - p|^2. Stick: p = 0. Slide: p is the
   // part of y_a - y_b along the interface (the plane normal to a's muscle
   // surface at a), so the muscles slide along each other but neither part
-  // nor enter each other there.
+  // nor enter each other there. The warm start carries a muscle by its
+  // neighbours' motion across the interfaces when they stick, and when they
+  // slide only a muscle with nothing driven.
   bool slide = false;
   double interface_weight = 1000.0;  // against the tetrahedra's, per pair
   int iterations = 10;               // local-global rounds per frame
