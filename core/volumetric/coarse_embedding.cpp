@@ -109,6 +109,31 @@ Eigen::Array3i grid_of(const Eigen::Vector3d& p, const Eigen::Vector3d& origin, 
   return ((p - origin) / spacing).array().round().cast<int>();
 }
 
+// Every output node of `model` placed in its coarse cell (place_node) and
+// the weights set: `simulated(v, cell)` and `node_of(v, grid)` for output
+// node v. Throws InvalidInputError for a node no simulated cell holds.
+template <typename Simulated, typename NodeOf>
+void embed_output_nodes(EmbeddedModel& model, const LabelledLattice& fine, int factor,
+                        const Eigen::Array3i& cells, const Simulated& simulated,
+                        const NodeOf& node_of) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(model.output.V.rows()) * 4);
+  model.host.resize(model.output.V.rows(), 4);
+  for (Eigen::Index v = 0; v < model.output.V.rows(); ++v) {
+    const Eigen::Array3i at =
+        grid_of(model.output.V.row(v).transpose(), fine.origin, fine.spacing_mm);
+    const bool placed = place_node(
+        at, factor, cells, [&](const Eigen::Array3i& cell) { return simulated(v, cell); },
+        [&](const Eigen::Array3i& grid) { return node_of(v, grid); }, model, v, triplets);
+    if (!placed) {
+      throw InvalidInputError("coarse embedding: fine node " + std::to_string(v) +
+                              " lies in no simulated coarse cell");
+    }
+  }
+  model.weights.resize(model.output.V.rows(), model.elements.V.rows());
+  model.weights.setFromTriplets(triplets.begin(), triplets.end());
+}
+
 }  // namespace
 
 EmbeddedModel embed_in_coarse_lattice(const LabelledLattice& fine, int factor) {
@@ -127,24 +152,12 @@ EmbeddedModel embed_in_coarse_lattice(const LabelledLattice& fine, int factor) {
   model.elements = lattice_tets(coarse);
   const std::unordered_map<GridKey, int> coarse_node =
       node_index(model.elements, coarse.origin, coarse.spacing_mm);
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(model.output.V.rows()) * 4);
-  model.host.resize(model.output.V.rows(), 4);
-  for (Eigen::Index v = 0; v < model.output.V.rows(); ++v) {
-    const Eigen::Array3i at =
-        grid_of(model.output.V.row(v).transpose(), fine.origin, fine.spacing_mm);
-    const bool placed = place_node(
-        at, factor, coarse.cells,
-        [&](const Eigen::Array3i& cell) { return coarse.at(cell.x(), cell.y(), cell.z()) != 0; },
-        [&](const Eigen::Array3i& grid) { return coarse_node.at(key_of(grid)); }, model, v,
-        triplets);
-    if (!placed) {
-      throw InvalidInputError("coarse embedding: fine node " + std::to_string(v) +
-                              " lies in no simulated coarse cell");
-    }
-  }
-  model.weights.resize(model.output.V.rows(), model.elements.V.rows());
-  model.weights.setFromTriplets(triplets.begin(), triplets.end());
+  embed_output_nodes(
+      model, fine, factor, coarse.cells,
+      [&](Eigen::Index, const Eigen::Array3i& cell) {
+        return coarse.at(cell.x(), cell.y(), cell.z()) != 0;
+      },
+      [&](Eigen::Index, const Eigen::Array3i& grid) { return coarse_node.at(key_of(grid)); });
   return model;
 }
 
@@ -274,28 +287,18 @@ EmbeddedModel embed_muscles_separately(const LabelledLattice& fine, int factor) 
           element_tets[t][static_cast<std::size_t>(a)];
   model.output = std::move(output);
   model.interfaces = std::move(interfaces);
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(model.output.V.rows()) * 4);
-  model.host.resize(model.output.V.rows(), 4);
-  for (Eigen::Index v = 0; v < model.output.V.rows(); ++v) {
-    const Part& part = parts[node_label[static_cast<std::size_t>(v)]];
-    const Eigen::Array3i at =
-        grid_of(model.output.V.row(v).transpose(), fine.origin, fine.spacing_mm);
-    const bool placed = place_node(
-        at, factor, coarse.cells,
-        [&](const Eigen::Array3i& cell) {
-          const Eigen::Array3i local = cell - part.low;
-          return (local >= 0).all() && (local < part.cells.cells).all() &&
-                 part.cells.at(local.x(), local.y(), local.z()) != 0;
-        },
-        [&](const Eigen::Array3i& grid) { return part.node.at(key_of(grid)); }, model, v, triplets);
-    if (!placed) {
-      throw InvalidInputError("coarse embedding: fine node " + std::to_string(v) +
-                              " lies in no coarse cell of its muscle");
-    }
-  }
-  model.weights.resize(model.output.V.rows(), model.elements.V.rows());
-  model.weights.setFromTriplets(triplets.begin(), triplets.end());
+  const auto part_of = [&](Eigen::Index v) -> const Part& {
+    return parts[node_label[static_cast<std::size_t>(v)]];
+  };
+  embed_output_nodes(
+      model, fine, factor, coarse.cells,
+      [&](Eigen::Index v, const Eigen::Array3i& cell) {
+        const Part& part = part_of(v);
+        const Eigen::Array3i local = cell - part.low;
+        return (local >= 0).all() && (local < part.cells.cells).all() &&
+               part.cells.at(local.x(), local.y(), local.z()) != 0;
+      },
+      [&](Eigen::Index v, const Eigen::Array3i& grid) { return part_of(v).node.at(key_of(grid)); });
   return model;
 }
 
