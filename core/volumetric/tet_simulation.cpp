@@ -363,7 +363,6 @@ TetSimulation::TetSimulation(EmbeddedModel model, std::vector<DrivenNode> driven
   }
   s.interfaces = s.model.interfaces;
   {
-    std::vector<int> first_pair(static_cast<std::size_t>(outputs), -1);
     std::vector<std::vector<int>> pairs_of(static_cast<std::size_t>(outputs));
     for (std::size_t k = 0; k < s.interfaces.size(); ++k) {
       const InterfacePair& pair = s.interfaces[k];
