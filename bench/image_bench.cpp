@@ -6,14 +6,30 @@
 //   BM_OverlayWindowOnly    the radiograph windowed to grey (percentiles), no item
 //   BM_OverlayTenBones      the same plus the 10 silhouettes: the operator's case
 //   BM_OverlayTenBonesLines the 10 silhouettes on a fixed window (no histogram)
+//
+// Accuracy table first (image.accuracy.txt): how far a pinhole fitted (DLT)
+// to an EOS-type slot scan of the whole leg (1700 mm tall, 0.38 mm pixels at
+// the isocentre) is from it, over the volume a leg fills (200 mm deep and
+// across, 1600 mm tall), per height band, in mm at the isocentre.
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <vector>
 
+#include "bench/bench_main.h"
 #include "core/image/outline_overlay.h"
 #include "core/image/projection.h"
+#include "core/image/view_fit.h"
 #include "core/mesh/primitives.h"
 
 namespace {
@@ -98,6 +114,70 @@ void BM_OverlayTenBonesLines(benchmark::State& state) {
 }
 BENCHMARK(BM_OverlayTenBonesLines)->Unit(benchmark::kMillisecond);
 
+// The pinhole-versus-slot table (see the file comment).
+void write_accuracy_table() {
+  mmm::image::BiplanarOptions options;
+  options.model = mmm::image::ProjectionModel::kSlotScanning;
+  options.isocentre_mm = {0, 0, 900};
+  options.field_height_mm = 1700.0;
+  options.detector_pixel_pitch_mm = 0.5;
+  const auto views = mmm::image::make_biplanar_views(options);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = -4; i <= 4; ++i) {
+    for (int j = -4; j <= 4; ++j) {
+      for (int k = -16; k <= 16; ++k) {
+        points.push_back(options.isocentre_mm + Eigen::Vector3d(25 * i, 25 * j, 50 * k));
+      }
+    }
+  }
+  // Height bands from the centre of the scan (mm).
+  const std::vector<std::pair<double, double>> bands = {
+      {0, 200}, {200, 500}, {500, 700}, {700, 801}};
+  std::ostringstream text;
+  nlohmann::json rows = nlohmann::json::array();
+  text << "pinhole fitted to a slot-scanning full-leg scan (1700 mm tall), error in mm at the "
+          "isocentre, points 200 mm deep and across\n"
+       << "view      | height from centre (mm) | mean  | max\n";
+  for (const mmm::image::RadiographView& view : views) {
+    std::vector<Eigen::Vector2d> pixels;
+    for (const Eigen::Vector3d& X : points) pixels.push_back(mmm::image::project(view, X));
+    const mmm::image::RadiographView pinhole = mmm::image::fit_pinhole_view(
+        points, pixels, view.name, view.width, view.height, view.pixel_spacing_mm);
+    for (const auto& [low, high] : bands) {
+      double sum = 0;
+      double worst = 0;
+      int count = 0;
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const double height = std::abs(points[i].z() - options.isocentre_mm.z());
+        if (height < low || height >= high) continue;
+        const double error =
+            (mmm::image::project(pinhole, points[i]) - pixels[i]).norm() * view.pixel_spacing_mm;
+        sum += error;
+        worst = std::max(worst, error);
+        ++count;
+      }
+      const std::string range = std::to_string(static_cast<int>(low)) + "-" +
+                                std::to_string(static_cast<int>(std::min(high, 800.0)));
+      text << std::left << std::setw(9) << view.name << " | " << std::setw(23) << range << " | "
+           << std::fixed << std::setprecision(2) << std::setw(5) << sum / count << " | " << worst
+           << "\n";
+      rows.push_back({{"view", view.name},
+                      {"height_from_mm", low},
+                      {"height_to_mm", std::min(high, 800.0)},
+                      {"mean_mm", sum / count},
+                      {"max_mm", worst}});
+    }
+  }
+  std::cout << text.str();
+  const char* out_dir = std::getenv("MMM_BENCH_OUT_DIR");
+  const std::filesystem::path folder = out_dir != nullptr ? out_dir : ".";
+  std::ofstream(folder / "image.accuracy.json")
+      << nlohmann::json{{"pinhole_vs_slot", rows}}.dump(2) << "\n";
+  std::ofstream(folder / "image.accuracy.txt") << text.str();
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  return mmm::bench::run_suite(argc, argv, "mmm_bench_image", write_accuracy_table);
+}

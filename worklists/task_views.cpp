@@ -20,6 +20,7 @@ RequestViews request_views(const image::RadiographPair& pair) {
                          {"width", view.width},
                          {"height", view.height},
                          {"pixel_spacing_mm", view.pixel_spacing_mm},
+                         {"model", image::projection_model_name(view.model)},
                          {"P", P},
                          {"image_sha256", sha}});
     out.images[view.name] = sha;
@@ -37,6 +38,17 @@ std::vector<image::RadiographView> views_of_request(const nlohmann::json& reques
     view.pixel_spacing_mm = entry.at("pixel_spacing_mm").get<double>();
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 4; ++c) view.P(r, c) = entry.at("P").at(r).at(c).get<double>();
+    }
+    // Requests written before slot-scanning views existed have no model.
+    const auto model = entry.find("model");
+    if (model != entry.end()) {
+      const std::optional<image::ProjectionModel> known =
+          image::projection_model_from_name(model->get<std::string>());
+      if (!known) {
+        throw InvalidInputError("the task's view '" + view.name + "' has the unknown model '" +
+                                model->get<std::string>() + "'");
+      }
+      view.model = *known;
     }
     view.source_mm = -view.P.leftCols<3>().inverse() * view.P.col(3);
     views.push_back(view);

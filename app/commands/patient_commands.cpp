@@ -30,12 +30,20 @@ struct SynthArgs {
   double pixel_pitch_mm = 0.5;
   bool local_shape = false;
   bool muscles_in_air = false;
+  bool pinhole = false;
   bool json = false;
 };
 
 constexpr const char* kMusclesInAirHelp =
     "Render the muscles as soft tissue standing in air, bone on top, rather than the limb filled "
     "with soft tissue that the bones replace (the default, as in a real radiograph)";
+constexpr const char* kPinholeHelp =
+    "Render two conventional (pinhole) radiographs rather than an EOS-type slot scan, conic "
+    "across the leg and parallel along it (the default)";
+
+image::ProjectionModel projection_model(bool pinhole) {
+  return pinhole ? image::ProjectionModel::kPinhole : image::ProjectionModel::kSlotScanning;
+}
 
 void run_synth(const SynthArgs& args) {
   atlas::SyntheticPatientOptions options;
@@ -44,6 +52,7 @@ void run_synth(const SynthArgs& args) {
   options.detector_pixel_pitch_mm = args.pixel_pitch_mm;
   options.deformation.local_shape = args.local_shape;
   options.soft_tissue_envelope = !args.muscles_in_air;
+  options.model = projection_model(args.pinhole);
   const atlas::SyntheticPatientReport report =
       atlas::make_synthetic_patient(args.atlas, args.out, options);
   if (args.json) {
@@ -88,6 +97,7 @@ struct BonesArgs {
   double pixel_pitch_mm = 0.5;
   bool local_shape = false;
   bool muscles_in_air = false;
+  bool pinhole = false;
 };
 
 void print_bone_patient(const atlas::BoneSetPatientReport& report, const std::string& out) {
@@ -113,6 +123,7 @@ atlas::PatientRadiographOptions radiograph_options(const BonesArgs& args) {
   options.detector_pixel_pitch_mm = args.pixel_pitch_mm;
   options.seed = args.seed;
   options.soft_tissue_envelope = !args.muscles_in_air;
+  options.model = projection_model(args.pinhole);
   return options;
 }
 
@@ -190,6 +201,7 @@ void register_patient_commands(CLI::App& app) {
                   "Add local shape to the long bones (torsion, bowing, bumps): what no smooth "
                   "map of the atlas produces");
   synth->add_flag("--muscles-in-air", args->muscles_in_air, kMusclesInAirHelp);
+  synth->add_flag("--pinhole", args->pinhole, kPinholeHelp);
   synth->add_flag("--json", args->json, "Print the drawn factors as JSON");
   synth->callback([args] { run_synth(*args); });
 
@@ -208,6 +220,7 @@ void register_patient_commands(CLI::App& app) {
                    "Detector pixel pitch (mm); 0.5 gives 0.38 mm at the isocentre")
       ->check(CLI::Range(0.05, 2.0));
   from_bones->add_flag("--muscles-in-air", bones->muscles_in_air, kMusclesInAirHelp);
+  from_bones->add_flag("--pinhole", bones->pinhole, kPinholeHelp);
   from_bones->callback([bones] { run_from_bones(*bones); });
 
   auto foreign = std::make_shared<BonesArgs>();
@@ -227,6 +240,7 @@ void register_patient_commands(CLI::App& app) {
   foreign_command->add_option("--pixel-pitch", foreign->pixel_pitch_mm, "Detector pixel pitch (mm)")
       ->check(CLI::Range(0.05, 2.0));
   foreign_command->add_flag("--muscles-in-air", foreign->muscles_in_air, kMusclesInAirHelp);
+  foreign_command->add_flag("--pinhole", foreign->pinhole, kPinholeHelp);
   foreign_command->callback([foreign] { run_foreign(*foreign); });
 
   auto clicks = std::make_shared<ClickArgs>();

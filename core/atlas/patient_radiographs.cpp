@@ -62,6 +62,7 @@ std::array<image::RadiographView, 2> write_patient_radiographs(
   geometry.source_to_isocentre_mm = options.source_to_isocentre_mm;
   geometry.source_to_detector_mm = options.source_to_detector_mm;
   geometry.detector_pixel_pitch_mm = options.detector_pixel_pitch_mm;
+  geometry.model = options.model;
   const Eigen::Vector3d size = box.sizes();
   geometry.field_width_mm = std::max(size.x(), size.y()) + 2 * options.field_margin_mm;
   geometry.field_height_mm = size.z() + 2 * options.field_margin_mm;

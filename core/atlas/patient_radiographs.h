@@ -30,6 +30,9 @@ struct PatientRadiographOptions {
   double source_to_detector_mm = 1700.0;
   double detector_pixel_pitch_mm = 0.5;  // 0.38 mm at the isocentre
   double field_margin_mm = 40.0;
+  // Slot-scanning views (an EOS-type scan: conic across, parallel along the
+  // leg) or pinhole views (two conventional radiographs).
+  image::ProjectionModel model = image::ProjectionModel::kSlotScanning;
   double mu_bone_per_mm = image::kBoneMuPerMm;
   double mu_soft_per_mm = image::kSoftTissueMuPerMm;
   // Soft tissue as in a real limb: an envelope around bones and muscles

@@ -132,6 +132,7 @@ SyntheticPatientReport make_synthetic_patient(const std::filesystem::path& atlas
   pictures.mu_bone_per_mm = options.mu_bone_per_mm;
   pictures.mu_soft_per_mm = options.mu_soft_per_mm;
   pictures.soft_tissue_envelope = options.soft_tissue_envelope;
+  pictures.model = options.model;
   pictures.radiograph = options.radiograph;
   pictures.seed = options.deformation.seed;
   pictures.threads = options.threads;

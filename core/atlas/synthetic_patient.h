@@ -35,8 +35,10 @@ struct SyntheticPatientOptions {
   double field_margin_mm = 40.0;
   double mu_bone_per_mm = image::kBoneMuPerMm;
   double mu_soft_per_mm = image::kSoftTissueMuPerMm;
-  std::string muscle_level = "lod1";    // muscles enter the DRR at this resolution
-  bool soft_tissue_envelope = true;     // the limb filled (patient_radiographs.h)
+  std::string muscle_level = "lod1";  // muscles enter the DRR at this resolution
+  bool soft_tissue_envelope = true;   // the limb filled (patient_radiographs.h)
+  // Slot-scanning (EOS-type) views, or a conventional pinhole pair.
+  image::ProjectionModel model = image::ProjectionModel::kSlotScanning;
   image::RadiographOptions radiograph;  // seed: the patient's seed unless set otherwise
   int threads = 2;
 };

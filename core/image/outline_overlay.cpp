@@ -333,7 +333,7 @@ void draw_view(const RadiographView& view, RgbImage8& canvas, std::span<const Ou
     const std::vector<Eigen::Vector2d> pixels =
         project_face_vertices(view, surface, "outline_overlay: " + item_label(items, k));
     const std::vector<std::array<int, 2>> edges =
-        keep_contour_pieces(silhouette_edges(surface, view.source_mm), options.min_contour_edges);
+        keep_contour_pieces(silhouette_edges(surface, view), options.min_contour_edges);
     for (const auto& [a, b] : edges) {
       painter.segment(pixels[static_cast<std::size_t>(a)], pixels[static_cast<std::size_t>(b)]);
     }

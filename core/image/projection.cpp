@@ -46,6 +46,12 @@ std::string format_vector(const Eigen::Vector3d& v) {
 // source positive (Hartley & Zisserman, eq. 6.15).
 double depth_sign(const Matrix34d& P) { return P.leftCols<3>().determinant() > 0 ? 1.0 : -1.0; }
 
+// A slot-scanning view's focal spot moves by this per image row:
+// M^-1 (0, 1, 0)^T, which changes v by one and u by nothing.
+Eigen::Vector3d scan_travel(const RadiographView& view) {
+  return view.P.leftCols<3>().partialPivLu().solve(Eigen::Vector3d::UnitY());
+}
+
 void check_positive(double value, const char* field) {
   if (!std::isfinite(value) || value <= 0) {
     throw InvalidInputError(std::string("BiplanarOptions.") + field +
@@ -77,6 +83,14 @@ RadiographView make_view(const BiplanarOptions& options, const std::string& name
   K << focal, 0, 0.5 * width, 0, focal, 0.5 * height, 0, 0, 1;
   view.P.leftCols<3>() = K * R;
   view.P.col(3) = -K * R * view.source_mm;
+  if (options.model == ProjectionModel::kSlotScanning) {
+    // Row v is the height over the scan step (the spacing at the isocentre,
+    // so that pixels are square there), centred like the pinhole's.
+    view.model = ProjectionModel::kSlotScanning;
+    view.P.block<1, 3>(1, 0) = v_axis.transpose() / view.pixel_spacing_mm;
+    view.P(1, 3) = 0.5 * height - v_axis.dot(options.isocentre_mm) / view.pixel_spacing_mm;
+    view.source_mm = -view.P.leftCols<3>().partialPivLu().solve(view.P.col(3));
+  }
   return view;
 }
 
@@ -183,6 +197,16 @@ class SidecarReader {
     if (spacing <= 0)
       fail(where, "field 'pixel_spacing_mm' must be > 0, got " + std::to_string(spacing));
     file.view.pixel_spacing_mm = spacing;
+    const auto model = entry.find("model");
+    if (model != entry.end()) {
+      const std::optional<ProjectionModel> known =
+          model->is_string() ? projection_model_from_name(model->get<std::string>()) : std::nullopt;
+      if (!known) {
+        fail(where,
+             "field 'model' must be \"pinhole\" or \"slot-scanning\", got " + describe(*model));
+      }
+      file.view.model = *known;
+    }
     file.view.source_mm = matrix(entry, where, "source_mm", 3, 0).col(0);
     file.view.P = matrix(entry, where, "P", 3, 4);
     try {
@@ -344,6 +368,39 @@ void validate_view(const RadiographView& view) {
   }
 }
 
+std::string projection_model_name(ProjectionModel model) {
+  return model == ProjectionModel::kSlotScanning ? "slot-scanning" : "pinhole";
+}
+
+std::optional<ProjectionModel> projection_model_from_name(std::string_view name) {
+  if (name == "pinhole") return ProjectionModel::kPinhole;
+  if (name == "slot-scanning") return ProjectionModel::kSlotScanning;
+  return std::nullopt;
+}
+
+Eigen::Vector3d source_for(const RadiographView& view, const Eigen::Vector3d& X) {
+  if (view.model == ProjectionModel::kPinhole) return view.source_mm;
+  const double row = view.P.row(1).dot(X.homogeneous());
+  return view.source_mm + row * scan_travel(view);
+}
+
+Eigen::Matrix<double, 2, 3> projection_jacobian(const RadiographView& view,
+                                                const Eigen::Vector3d& X) {
+  const Eigen::Vector3d h = view.P * X.homogeneous();
+  Eigen::Matrix<double, 2, 3> J;
+  J.row(0) = (view.P.block<1, 3>(0, 0) - h.x() / h.z() * view.P.block<1, 3>(2, 0)) / h.z();
+  if (view.model == ProjectionModel::kSlotScanning) {
+    J.row(1) = view.P.block<1, 3>(1, 0);
+  } else {
+    J.row(1) = (view.P.block<1, 3>(1, 0) - h.y() / h.z() * view.P.block<1, 3>(2, 0)) / h.z();
+  }
+  return J;
+}
+
+double depth_mm(const RadiographView& view, const Eigen::Vector3d& X) {
+  return depth_sign(view.P) * view.P.row(2).dot(X.homogeneous()) / view.P.block<1, 3>(2, 0).norm();
+}
+
 Eigen::Vector2d project(const RadiographView& view, const Eigen::Vector3d& X) {
   if (!X.allFinite()) {
     throw InvalidInputError(view_label(view) + ": cannot project the non-finite point " +
@@ -354,6 +411,7 @@ Eigen::Vector2d project(const RadiographView& view, const Eigen::Vector3d& X) {
     throw InvalidInputError(view_label(view) + ": point " + format_vector(X) +
                             " lies on or behind the source plane and casts no image");
   }
+  if (view.model == ProjectionModel::kSlotScanning) return {h.x() / h.z(), h.y()};
   return h.hnormalized();
 }
 
@@ -362,6 +420,16 @@ Ray backproject(const RadiographView& view, const Eigen::Vector2d& pixel) {
     throw InvalidInputError(view_label(view) + ": cannot back-project a non-finite pixel");
   }
   const Eigen::Matrix3d M = view.P.leftCols<3>();
+  if (view.model == ProjectionModel::kSlotScanning) {
+    // In the horizontal plane of row v, from the focal spot lighting it:
+    // M d = c (u, 0, 1) keeps v and gives column u.
+    const Eigen::Vector3d direction = M.partialPivLu().solve(Eigen::Vector3d(pixel.x(), 0, 1));
+    const Eigen::Vector3d origin = view.source_mm + pixel.y() * scan_travel(view);
+    if (!direction.allFinite() || direction.squaredNorm() == 0 || !origin.allFinite()) {
+      throw InvalidInputError(view_label(view) + ": P is singular; cannot back-project");
+    }
+    return {origin, depth_sign(view.P) * direction.normalized()};
+  }
   const Eigen::Vector3d direction = M.partialPivLu().solve(pixel.homogeneous());
   if (!direction.allFinite() || direction.squaredNorm() == 0) {
     throw InvalidInputError(view_label(view) + ": P is singular; cannot back-project");
@@ -431,9 +499,18 @@ Eigen::Vector3d triangulate_linear(std::span<const RadiographView> views,
         if (depth > 0) weight /= depth;
       }
       for (int r = 0; r < 2; ++r) {
-        const Eigen::RowVector4d row = pixels[k](r) * P.row(2) - P.row(r);
-        A.row(2 * i + r) = weight * row.head<3>();
-        b(2 * i + r) = -weight * row(3);
+        Eigen::RowVector4d row = pixels[k](r) * P.row(2) - P.row(r);
+        double row_weight = weight;
+        if (r == 1 && views[k].model == ProjectionModel::kSlotScanning) {
+          // v itself is affine: (v e4 - p2) . [X 1], in rows; over the rows
+          // per mm it is mm at every depth.
+          const Eigen::RowVector4d& p2 = views[k].P.row(1);
+          row = -p2;
+          row(3) += pixels[k](1);
+          row_weight = 1.0 / p2.head<3>().norm();
+        }
+        A.row(2 * i + r) = row_weight * row.head<3>();
+        b(2 * i + r) = -row_weight * row(3);
       }
     }
     X = A.colPivHouseholderQr().solve(b);
@@ -484,6 +561,9 @@ std::string view_sidecar_text(std::span<const RadiographFile> views) {
     text += "      \"image\": " + Json(views[i].image).dump() + ",\n";
     text += "      \"width\": " + std::to_string(view.width) + ",\n";
     text += "      \"height\": " + std::to_string(view.height) + ",\n";
+    if (view.model != ProjectionModel::kPinhole) {
+      text += "      \"model\": " + Json(projection_model_name(view.model)).dump() + ",\n";
+    }
     text += "      \"pixel_spacing_mm\": " + Json(view.pixel_spacing_mm).dump() + ",\n";
     text += "      \"source_mm\": " + row(view.source_mm) + ",\n";
     text += "      \"P\": [" + row(view.P.row(0)) + ",\n";

@@ -4,15 +4,29 @@
 // of a point seen in two or more views, and the JSON sidecar that stores a
 // calibrated pair beside its images.
 //
-// Model: a view is a 3 x 4 matrix P with [u v 1]^T ~ P [X 1]^T (Hartley &
-// Zisserman, "Multiple View Geometry", 2nd ed., ch. 6); the X-ray focal spot
-// is the centre of projection (P [source 1]^T = 0). Real EOS scanners are
-// conic horizontally but parallel vertically (source and detector move up
-// together); a pinhole matrix fitted to their calibration is the usual
-// approximation, exact for the views make_biplanar_views builds.
+// Two projection models, both held in one 3 x 4 matrix P (h = P [X 1]^T):
+//   pinhole        [u v 1]^T ~ h: u = h0 / h2, v = h1 / h2 (Hartley &
+//                  Zisserman, "Multiple View Geometry", 2nd ed., ch. 6); the
+//                  X-ray focal spot is the centre of projection
+//                  (P [source 1]^T = 0). A conventional radiograph.
+//   slot scanning  u = h0 / h2, v = h1: conic across the image, parallel along
+//                  it. The source and a line detector move together along the
+//                  scan (vertically, on an EOS-type system), so a point is
+//                  seen from the focal spot at its own height: its row v is
+//                  its height over the scan step, whatever its depth, while
+//                  its column is a pinhole's within that horizontal plane.
+//                  P is not defined up to scale here (row 1 gives v itself).
+//                  The focal spot at row v is source_mm + v t, where
+//                  source_mm is the one at row 0 (still -M^-1 p4 for P =
+//                  [M | p4]) and t = M^-1 (0, 1, 0)^T is the scan's travel per
+//                  row.
+// A pinhole matrix fitted to a slot-scanning view is exact only at one height
+// and one depth: over a full-leg scan it is off by millimetres at the ends of
+// the image (see tests/core/image/slot_scanning_test.cpp and the benchmarks).
 //
 // Triangulation (linear, "DLT"): each view gives two equations linear in X,
 //   (u p3 - p1) . [X 1] = 0,   (v p3 - p2) . [X 1] = 0   (p_i = row i of P),
+// the second being (v e4 - p2) . [X 1] = 0 for a slot-scanning view,
 // solved in least squares for the 3 coordinates. The residual of such a row
 // is depth * (pixel error); a second solve divides each view's rows by the
 // depth found by the first and multiplies them by the view's pixel spacing,
@@ -38,16 +52,27 @@
 #include <Eigen/Core>
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace mmm::image {
 
+// How a view maps the world to its pixels (see the file comment).
+enum class ProjectionModel { kPinhole, kSlotScanning };
+
+// "pinhole" or "slot-scanning" (as in the sidecar), and back (std::nullopt
+// for another text).
+std::string projection_model_name(ProjectionModel model);
+std::optional<ProjectionModel> projection_model_from_name(std::string_view name);
+
 struct RadiographView {
   std::string name;  // "frontal", "lateral", ...
-  // Maps homogeneous world points (mm) to homogeneous pixels (u, v, 1) up to
-  // scale; pixel centres at integer + 0.5 (see above).
+  ProjectionModel model = ProjectionModel::kPinhole;
+  // Maps homogeneous world points (mm) to pixels (u, v) as `model` says;
+  // pixel centres at integer + 0.5 (see above).
   Eigen::Matrix<double, 3, 4> P = Eigen::Matrix<double, 3, 4>::Zero();
   int width = 0;   // pixels (u in [0, width])
   int height = 0;  // pixels (v in [0, height])
@@ -56,7 +81,8 @@ struct RadiographView {
   // source_to_detector / source_to_isocentre. An object at the isocentre
   // measures this many mm per pixel.
   double pixel_spacing_mm = 0;
-  // X-ray focal spot (mm, world): the centre of projection of P.
+  // X-ray focal spot (mm, world): the centre of projection of P (for a
+  // slot-scanning view, the focal spot when it lights row v = 0).
   Eigen::Vector3d source_mm = Eigen::Vector3d::Zero();
 };
 
@@ -85,6 +111,10 @@ struct BiplanarOptions {
   // the isocentre, rounded to the nearest pixel.
   double field_width_mm = 450.0;
   double field_height_mm = 1100.0;
+  // Pinhole views (a conventional pair) or slot-scanning ones (an EOS-type
+  // scan: square pixels of the same spacing at the isocentre, every row seen
+  // from the focal spot at its own height).
+  ProjectionModel model = ProjectionModel::kPinhole;
 };
 
 // The calibrated pair {frontal, lateral} described by `options` (names
@@ -101,14 +131,27 @@ std::array<RadiographView, 2> make_biplanar_views(const BiplanarOptions& options
 // origin): rounding, not a second focal spot.
 void validate_view(const RadiographView& view);
 
+// The focal spot from which X is seen: source_mm for a pinhole view; for a
+// slot-scanning view the spot at X's row (see the file comment).
+Eigen::Vector3d source_for(const RadiographView& view, const Eigen::Vector3d& X);
+
+// d(u, v) / dX at the world point X (pixels per mm), for either model.
+Eigen::Matrix<double, 2, 3> projection_jacobian(const RadiographView& view,
+                                                const Eigen::Vector3d& X);
+
+// Depth of X in front of the source along the beam, in mm (> 0 in front):
+// the distance, along the view's axis, from the plane through the source
+// parallel to the detector.
+double depth_mm(const RadiographView& view, const Eigen::Vector3d& X);
+
 // Pixel (u, v) of the world point X (mm). Throws InvalidInputError when X is
 // not finite or lies on or behind the plane through the source parallel to
 // the detector (it casts no shadow on the detector).
 Eigen::Vector2d project(const RadiographView& view, const Eigen::Vector3d& X);
 
-// The ray from the source through pixel position (u, v), pointing toward the
-// detector. Throws InvalidInputError for a non-finite pixel or a view whose
-// P is singular.
+// The ray from the source (for a slot-scanning view: from the focal spot at
+// row v) through pixel position (u, v), pointing toward the detector. Throws InvalidInputError for
+// a non-finite pixel or a view whose P is singular.
 Ray backproject(const RadiographView& view, const Eigen::Vector2d& pixel);
 
 // Least-squares linear triangulation of one point seen at pixels[i] in
@@ -136,6 +179,7 @@ struct RadiographFile {
 // Writes the views as JSON:
 //   {"format": "mmm-radiograph-views", "version": 1,
 //    "views": [{"name": "frontal", "image": "frontal.png", "width": 1962,
+//               ["model": "slot-scanning",] (absent: "pinhole")
 //               "height": 4795, "pixel_spacing_mm": 0.229,
 //               "source_mm": [x, y, z], "P": [[4 numbers], [..], [..]]}, ...]}
 // Numbers are written as the shortest text that reads back to the same

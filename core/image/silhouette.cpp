@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <utility>
 
@@ -78,20 +79,24 @@ std::vector<Eigen::Vector2d> project_face_vertices(const RadiographView& view,
                               std::to_string(p.z()) +
                               ") lies on or behind the source plane (wrong frame or units?)");
     }
-    pixels[static_cast<std::size_t>(v)] = h.hnormalized();
+    pixels[static_cast<std::size_t>(v)] = project(view, p);
   }
   return pixels;
 }
 
-std::vector<std::array<int, 2>> silhouette_edges(const mesh::IndexedMesh& surface,
-                                                 const Eigen::Vector3d& source) {
+namespace {
+
+std::vector<std::array<int, 2>> silhouette_edges_from(
+    const mesh::IndexedMesh& surface,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& source_of) {
   const Eigen::Index faces = surface.F.rows();
   std::vector<int> side(static_cast<std::size_t>(faces));
   for (Eigen::Index f = 0; f < faces; ++f) {
     const Eigen::Vector3d a = surface.V.row(surface.F(f, 0)).transpose();
     const Eigen::Vector3d b = surface.V.row(surface.F(f, 1)).transpose();
     const Eigen::Vector3d c = surface.V.row(surface.F(f, 2)).transpose();
-    const double facing = (b - a).cross(c - a).dot((a + b + c) / 3.0 - source);
+    const Eigen::Vector3d centroid = (a + b + c) / 3.0;
+    const double facing = (b - a).cross(c - a).dot(centroid - source_of(centroid));
     side[static_cast<std::size_t>(f)] = (facing > 0) - (facing < 0);
   }
   struct Corner {
@@ -129,6 +134,19 @@ std::vector<std::array<int, 2>> silhouette_edges(const mesh::IndexedMesh& surfac
     begin = end;
   }
   return edges;
+}
+
+}  // namespace
+
+std::vector<std::array<int, 2>> silhouette_edges(const mesh::IndexedMesh& surface,
+                                                 const Eigen::Vector3d& source) {
+  return silhouette_edges_from(surface, [&](const Eigen::Vector3d&) { return source; });
+}
+
+std::vector<std::array<int, 2>> silhouette_edges(const mesh::IndexedMesh& surface,
+                                                 const RadiographView& view) {
+  return silhouette_edges_from(surface,
+                               [&](const Eigen::Vector3d& x) { return source_for(view, x); });
 }
 
 std::vector<std::array<int, 2>> keep_contour_pieces(const std::vector<std::array<int, 2>>& edges,
@@ -173,7 +191,7 @@ std::vector<Polyline2d> silhouette_polylines(const mesh::IndexedMesh& surface,
   const std::vector<Eigen::Vector2d> pixels =
       project_face_vertices(view, surface, "silhouette_polylines");
   const std::vector<std::array<int, 2>> edges =
-      keep_contour_pieces(silhouette_edges(surface, view.source_mm), min_contour_edges);
+      keep_contour_pieces(silhouette_edges(surface, view), min_contour_edges);
   for (const std::vector<int>& chain : chain_edges(edges)) {
     Polyline2d polyline;
     polyline.reserve(chain.size());

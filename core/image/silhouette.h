@@ -34,6 +34,11 @@ namespace mmm::image {
 // `source` (mm, the mesh's frame), each once, ordered by (low, high) index.
 std::vector<std::array<int, 2>> silhouette_edges(const mesh::IndexedMesh& surface,
                                                  const Eigen::Vector3d& source);
+// The same seen in `view`: each face from the focal spot that lights it
+// (source_for: one spot for a pinhole, the spot at the face's height for a
+// slot-scanning view).
+std::vector<std::array<int, 2>> silhouette_edges(const mesh::IndexedMesh& surface,
+                                                 const RadiographView& view);
 
 // The edges that belong to connected pieces of at least `min_edges` edges,
 // or to the largest pieces, in their input order; all of them for

@@ -16,11 +16,12 @@ namespace {
 // Residual of one view: (projection - observed pixel) * pixel spacing (mm).
 struct ReprojectionResidual {
   ReprojectionResidual(Eigen::Matrix<double, 3, 4> P, Eigen::Vector2d pixel, double spacing_mm,
-                       double depth_sign)
+                       double depth_sign, bool slot_scanning)
       : P_(std::move(P)),
         pixel_(std::move(pixel)),
         spacing_mm_(spacing_mm),
-        depth_sign_(depth_sign) {}
+        depth_sign_(depth_sign),
+        slot_scanning_(slot_scanning) {}
 
   template <typename T>
   bool operator()(const T* const X, T* residual) const {
@@ -32,7 +33,9 @@ struct ReprojectionResidual {
     // Ceres the step is infeasible so that it shortens it.
     if (!(h[2] * T(depth_sign_) > T(0))) return false;
     residual[0] = (h[0] / h[2] - T(pixel_.x())) * T(spacing_mm_);
-    residual[1] = (h[1] / h[2] - T(pixel_.y())) * T(spacing_mm_);
+    // A slot-scanning view's row is affine in X (projection.h).
+    const T v = slot_scanning_ ? h[1] : h[1] / h[2];
+    residual[1] = (v - T(pixel_.y())) * T(spacing_mm_);
     return true;
   }
 
@@ -41,6 +44,7 @@ struct ReprojectionResidual {
   Eigen::Vector2d pixel_;
   double spacing_mm_;
   double depth_sign_;
+  bool slot_scanning_;
 };
 
 void check_options(const TriangulationOptions& options) {
@@ -75,7 +79,8 @@ Triangulation triangulate(std::span<const image::RadiographView> views,
     const double sign = view.P.leftCols<3>().determinant() > 0 ? 1.0 : -1.0;
     problem.AddResidualBlock(
         new ceres::AutoDiffCostFunction<ReprojectionResidual, 2, 3>(
-            new ReprojectionResidual(view.P, pixels[i], view.pixel_spacing_mm, sign)),
+            new ReprojectionResidual(view.P, pixels[i], view.pixel_spacing_mm, sign,
+                                     view.model == image::ProjectionModel::kSlotScanning)),
         nullptr, X.data());
   }
   ceres::Solver::Options solver_options;

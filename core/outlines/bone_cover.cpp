@@ -17,7 +17,6 @@ BoneCover::BoneCover(const mesh::IndexedMesh& surface, const image::RadiographVi
   const Eigen::Index n = surface.V.rows();
   std::vector<Eigen::Vector2d> pixel(static_cast<std::size_t>(n));
   std::vector<bool> in_front(static_cast<std::size_t>(n));
-  const Eigen::Vector3d axis = (view.P.block<1, 3>(2, 0)).transpose();
   double lo_x = view.width;
   double lo_y = view.height;
   double hi_x = 0.0;
@@ -25,7 +24,7 @@ BoneCover::BoneCover(const mesh::IndexedMesh& surface, const image::RadiographVi
   for (Eigen::Index i = 0; i < n; ++i) {
     const Eigen::Vector3d x = surface.V.row(i).transpose();
     const auto k = static_cast<std::size_t>(i);
-    in_front[k] = axis.dot(x) + view.P(2, 3) > 0;
+    in_front[k] = image::depth_mm(view, x) > 0;
     if (!in_front[k]) continue;
     pixel[k] = image::project(view, x);
     lo_x = std::min(lo_x, pixel[k].x());

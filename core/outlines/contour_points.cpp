@@ -7,17 +7,6 @@
 
 namespace mmm::outlines {
 
-Eigen::Matrix<double, 2, 3> projection_jacobian(const image::RadiographView& view,
-                                                const Eigen::Vector3d& X) {
-  const Eigen::Vector3d h = view.P.leftCols<3>() * X + view.P.col(3);
-  const double u = h.x() / h.z();
-  const double v = h.y() / h.z();
-  Eigen::Matrix<double, 2, 3> J;
-  J.row(0) = (view.P.block<1, 3>(0, 0) - u * view.P.block<1, 3>(2, 0)) / h.z();
-  J.row(1) = (view.P.block<1, 3>(1, 0) - v * view.P.block<1, 3>(2, 0)) / h.z();
-  return J;
-}
-
 std::vector<ContourPoint> contour_points(const mesh::IndexedMesh& surface,
                                          const image::RadiographView& view) {
   const Eigen::Index nv = surface.V.rows();
@@ -31,7 +20,8 @@ std::vector<ContourPoint> contour_points(const mesh::IndexedMesh& surface,
   }
   Eigen::VectorXd side(nv);
   for (Eigen::Index i = 0; i < nv; ++i) {
-    const Eigen::Vector3d ray = surface.V.row(i).transpose() - view.source_mm;
+    const Eigen::Vector3d x = surface.V.row(i).transpose();
+    const Eigen::Vector3d ray = x - image::source_for(view, x);
     const double length = normals.row(i).norm();
     if (length > 0) normals.row(i) /= length;
     side[i] = normals.row(i).dot(ray.normalized());
@@ -48,7 +38,6 @@ std::vector<ContourPoint> contour_points(const mesh::IndexedMesh& surface,
   }
   std::ranges::sort(edges);
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  const Eigen::Vector3d axis = view.P.block<1, 3>(2, 0).transpose();  // toward the detector
   std::vector<ContourPoint> out;
   for (const auto& [a, b] : edges) {
     const double ga = side[a];
@@ -60,7 +49,7 @@ std::vector<ContourPoint> contour_points(const mesh::IndexedMesh& surface,
     point.t = ga / (ga - gb);
     point.position =
         (1 - point.t) * surface.V.row(a).transpose() + point.t * surface.V.row(b).transpose();
-    if ((point.position - view.source_mm).dot(axis) <= 0) continue;
+    if (image::depth_mm(view, point.position) <= 0) continue;
     const Eigen::Vector3d normal =
         ((1 - point.t) * normals.row(a) + point.t * normals.row(b)).transpose();
     const Eigen::Vector2d projected = projection_jacobian(view, point.position) * normal;

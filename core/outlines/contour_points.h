@@ -30,9 +30,7 @@ struct ContourPoint {
   Eigen::Vector2d outward = Eigen::Vector2d::Zero();  // unit, image plane
 };
 
-// The projection Jacobian d(u, v)/dX at X (pixels per mm).
-Eigen::Matrix<double, 2, 3> projection_jacobian(const image::RadiographView& view,
-                                                const Eigen::Vector3d& X);
+using image::projection_jacobian;
 
 // Contour points of `surface` (closed, outward-oriented) seen from `view`'s
 // source; vertices behind the source plane give none.

@@ -168,10 +168,48 @@
 
   // The epipolar line in view `to` of pixel (u, v) of view `from`, as
   // homogeneous line coefficients (a u + b v + c = 0): the images of the
-  // camera centre and of another point of the ray.
+  // camera centre and of another point of the ray. Pinhole views only.
   function epipolarLine(from, to, u, v) {
     const ray = backProject(from.P, [u, v, 1]);
     return cross(project(to.P, cameraCentre(from.P)), project(to.P, ray));
+  }
+
+  // Slot-scanning views (spec.model "slot-scanning", core/image/projection.h):
+  // u = h0 / h2 but v = h1, and row v is seen from the focal spot at its own
+  // height. The epipolar curve is then sampled along the ray.
+  const isSlot = (spec) => spec.model === "slot-scanning";
+  const solve3 = (M, b) => {
+    const d = det3(M);
+    return [0, 1, 2].map((k) => det3(M.map((row, r) => row.map((x, c) => (c === k ? b[r] : x)))) / d);
+  };
+  function pixelOf(spec, X) {
+    const h = project(spec.P, [X[0], X[1], X[2], 1]);
+    if (!(h[2] * Math.sign(det3(spec.P.map((row) => row.slice(0, 3)))) > 0)) return null;
+    return isSlot(spec) ? [h[0] / h[2], h[1]] : [h[0] / h[2], h[1] / h[2]];
+  }
+  // Origin (the focal spot) and direction of the ray through pixel (u, v).
+  function rayOf(spec, u, v) {
+    const M = spec.P.map((row) => row.slice(0, 3));
+    const p4 = spec.P.map((row) => -row[3]);
+    const source = solve3(M, p4);
+    const sign = Math.sign(det3(M));
+    if (!isSlot(spec)) return [source, solve3(M, [u, v, 1]).map((x) => sign * x)];
+    const travel = solve3(M, [0, 1, 0]);
+    return [source.map((s, k) => s + v * travel[k]), solve3(M, [u, 0, 1]).map((x) => sign * x)];
+  }
+  // The epipolar curve as image points of `to` inside the image, or null.
+  function epipolarCurve(from, to, u, v, w, h) {
+    if (!isSlot(from) && !isSlot(to)) return clipLine(epipolarLine(from, to, u, v), w, h);
+    const [origin, direction] = rayOf(from, u, v);
+    const norm = Math.hypot(...direction);
+    // Every 5 mm along the first 4 m of the ray (beyond any detector).
+    const points = [];
+    for (let i = 1; i <= 800; i++) {
+      const t = (5 * i) / norm;
+      const p = pixelOf(to, origin.map((x, k) => x + t * direction[k]));
+      if (p && p[0] >= 0 && p[0] <= w && p[1] >= 0 && p[1] <= h) points.push(p);
+    }
+    return points.length >= 2 ? points : null;
   }
 
   // The segment of line l inside [0, w] x [0, h], or null.
@@ -502,15 +540,17 @@
         for (const other of this.views) {
           const p = this.points[active.name][other.spec.name];
           if (other === view || !p) continue;
-          const segment = clipLine(epipolarLine(other.spec, view.spec, p[0], p[1]), view.imageWidth, view.imageHeight);
-          if (!segment) continue;
-          const [a, b] = segment.map(([u, v]) => view.toScreen(u, v));
+          const curve = epipolarCurve(other.spec, view.spec, p[0], p[1], view.imageWidth, view.imageHeight);
+          if (!curve) continue;
+          const screen = curve.map(([u, v]) => view.toScreen(u, v));
           context.save();
           context.strokeStyle = COLOURS[this.active % COLOURS.length];
           context.globalAlpha = 0.8;
           context.setLineDash([8, 6]);
           context.lineWidth = 1.5;
-          context.beginPath(); context.moveTo(a[0], a[1]); context.lineTo(b[0], b[1]); context.stroke();
+          context.beginPath();
+          screen.forEach(([x, y], i) => (i === 0 ? context.moveTo(x, y) : context.lineTo(x, y)));
+          context.stroke();
           context.restore();
         }
       }
