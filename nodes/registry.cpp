@@ -1,5 +1,7 @@
 #include "nodes/registry.h"
 
+#include "core/image/deidentified_radiograph.h"
+#include "core/image/dicom_radiograph.h"
 #include "nodes/build_hulls.h"
 #include "nodes/build_muscle_lattice.h"
 #include "nodes/decimate_mesh.h"
@@ -39,6 +41,14 @@ workflow::NodeRegistry make_node_registry() {
   registry.add<WrapMuscles>();
   registry.add<SimulateMuscles>();
   registry.add<DecomposeFibres>();
+  // A DICOM file given to a study is stored de-identified (PS3.15 Annex E):
+  // its pixels and geometry, the SOP Instance UID only as a hash.
+  registry.add_file_importer({"DICOM de-identification",
+                              [](std::string_view head) { return image::looks_like_dicom(head); },
+                              [](std::string_view bytes, const std::filesystem::path& origin) {
+                                return image::deidentified_radiograph_text(
+                                    image::read_dicom_radiograph(bytes, origin));
+                              }});
   return registry;
 }
 

@@ -26,6 +26,21 @@ void NodeRegistry::add(NodeSpec spec, RunFunction run, ManualTaskBehaviour task)
   types_.emplace(std::move(name), NodeType{std::move(spec), std::move(run), std::move(task)});
 }
 
+void NodeRegistry::add_file_importer(FileImporter importer) {
+  if (!importer.accepts || !importer.convert) {
+    throw InvalidInputError("file importer '" + importer.name +
+                            "' needs both an accepts and a convert function");
+  }
+  importers_.push_back(std::move(importer));
+}
+
+const FileImporter* NodeRegistry::importer_for(std::string_view head) const {
+  for (const FileImporter& importer : importers_) {
+    if (importer.accepts(head)) return &importer;
+  }
+  return nullptr;
+}
+
 const NodeType* NodeRegistry::find(std::string_view name) const {
   const auto it = types_.find(name);
   return it == types_.end() ? nullptr : &it->second;

@@ -17,6 +17,7 @@
 //   };
 //   registry.add<LandmarkStation>();
 
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
@@ -37,6 +38,20 @@ struct NodeType {
   RunFunction run;
   ManualTaskBehaviour task;  // manual node types only (complete); empty otherwise
 };
+
+// What a study stores in place of a file given as an input, when the file is
+// of a kind that must not be kept as it is (a DICOM radiograph carries the
+// patient's name, IDs and dates: only its pixels and geometry are kept).
+struct FileImporter {
+  std::string name;  // for messages, e.g. "DICOM de-identification"
+  // Decides from the first kImporterHeadBytes of the file (fewer for a
+  // shorter file).
+  std::function<bool(std::string_view head)> accepts;
+  // The bytes to store instead; throws IoError naming `origin` when the file
+  // cannot be converted (the study input is then refused).
+  std::function<std::string(std::string_view bytes, const std::filesystem::path& origin)> convert;
+};
+inline constexpr std::size_t kImporterHeadBytes = 132;
 
 class NodeRegistry {
  public:
@@ -60,8 +75,15 @@ class NodeRegistry {
   // Names close to `name` (edit distance <= 2 or a shared prefix), for hints.
   [[nodiscard]] std::vector<std::string> similar_names(std::string_view name) const;
 
+  // File importers are tried in the order added; the first that accepts a
+  // file converts it.
+  void add_file_importer(FileImporter importer);
+  // The importer that accepts a file starting with `head`, or nullptr.
+  [[nodiscard]] const FileImporter* importer_for(std::string_view head) const;
+
  private:
   std::map<std::string, NodeType, std::less<>> types_;
+  std::vector<FileImporter> importers_;
 };
 
 }  // namespace mmm::workflow

@@ -16,7 +16,16 @@ RequestViews request_views(const image::RadiographPair& pair) {
       P.push_back({view.P(r, 0), view.P(r, 1), view.P(r, 2), view.P(r, 3)});
     }
     const std::string sha = pair.image_sha256(view.name);
+    nlohmann::json origin = nullptr;
+    const auto known = pair.origins.find(file.image);
+    if (known != pair.origins.end()) {
+      // A DICOM radiograph's own window, and its SOP Instance UID's hash for
+      // the audit trail (the request is recorded with every decision).
+      origin = {{"window", {known->second.window_centre, known->second.window_width}},
+                {"sop_instance_uid_sha256", known->second.sop_instance_uid_sha256}};
+    }
     out.views.push_back({{"name", view.name},
+                         {"dicom", origin},
                          {"width", view.width},
                          {"height", view.height},
                          {"pixel_spacing_mm", view.pixel_spacing_mm},

@@ -51,6 +51,9 @@ struct Image {
   // Sample access without bounds checks (x in [0, width), y in [0, height)).
   [[nodiscard]] T& at(int x, int y, int c = 0) { return pixels[index(x, y, c)]; }
   [[nodiscard]] const T& at(int x, int y, int c = 0) const { return pixels[index(x, y, c)]; }
+
+  // Same size and samples.
+  friend bool operator==(const Image&, const Image&) = default;
 };
 
 using GrayImage8 = Image<std::uint8_t, 1>;

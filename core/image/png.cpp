@@ -140,7 +140,7 @@ std::vector<std::uint8_t> raw_bytes(const ImageT& image) {
 }
 
 template <typename ImageT>
-std::string encode_png(const ImageT& image, int colour_type, const PngWriteOptions& options) {
+std::string encode_png_bytes(const ImageT& image, int colour_type, const PngWriteOptions& options) {
   using Sample = typename ImageT::Sample;
   if (image.width <= 0 || image.height <= 0) {
     throw InvalidInputError("cannot write an empty image as PNG (size " +
@@ -219,15 +219,27 @@ std::string encode_png(const ImageT& image, int colour_type, const PngWriteOptio
 }  // namespace
 
 void write_png(const GrayImage8& image, const fs::path& path, const PngWriteOptions& options) {
-  write_file_atomically(path, encode_png(image, kGray, options));
+  write_file_atomically(path, encode_png_bytes(image, kGray, options));
 }
 
 void write_png(const GrayImage16& image, const fs::path& path, const PngWriteOptions& options) {
-  write_file_atomically(path, encode_png(image, kGray, options));
+  write_file_atomically(path, encode_png_bytes(image, kGray, options));
 }
 
 void write_png(const RgbImage8& image, const fs::path& path, const PngWriteOptions& options) {
-  write_file_atomically(path, encode_png(image, kRgb, options));
+  write_file_atomically(path, encode_png_bytes(image, kRgb, options));
+}
+
+std::string encode_png(const GrayImage8& image, const PngWriteOptions& options) {
+  return encode_png_bytes(image, kGray, options);
+}
+
+std::string encode_png(const GrayImage16& image, const PngWriteOptions& options) {
+  return encode_png_bytes(image, kGray, options);
+}
+
+std::string encode_png(const RgbImage8& image, const PngWriteOptions& options) {
+  return encode_png_bytes(image, kRgb, options);
 }
 
 }  // namespace mmm::image

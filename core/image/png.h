@@ -73,6 +73,12 @@ void write_png(const GrayImage16& image, const std::filesystem::path& path,
 void write_png(const RgbImage8& image, const std::filesystem::path& path,
                const PngWriteOptions& options = {});
 
+// The bytes write_png would write, for a PNG held in memory (e.g. embedded
+// in a JSON artifact). Throws what write_png throws for the image and options.
+std::string encode_png(const GrayImage8& image, const PngWriteOptions& options = {});
+std::string encode_png(const GrayImage16& image, const PngWriteOptions& options = {});
+std::string encode_png(const RgbImage8& image, const PngWriteOptions& options = {});
+
 // What read_png found: the image in the format the file stores and the tEXt
 // chunks in file order.
 struct PngContent {

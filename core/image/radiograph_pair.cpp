@@ -120,6 +120,11 @@ std::string radiograph_pair_to_json_text(const RadiographPair& pair) {
   for (const RadiographFile& file : pair.views) {
     const std::string& png = pair.images.at(file.image);
     images[file.image] = {{"sha256", hash::sha256_hex(png)}, {"png_base64", base64_encode(png)}};
+    const auto origin = pair.origins.find(file.image);
+    if (origin != pair.origins.end()) {
+      images[file.image]["window"] = {origin->second.window_centre, origin->second.window_width};
+      images[file.image]["sop_instance_uid_sha256"] = origin->second.sop_instance_uid_sha256;
+    }
   }
   root["images"] = std::move(images);
   return root.dump();
@@ -163,6 +168,19 @@ RadiographPair radiograph_pair_from_json_text(const std::string& text, const fs:
     }
     check_image(file, png, source);
     pair.images.emplace(file.image, std::move(png));
+    if (it->contains("window")) {
+      const Json& window = (*it)["window"];
+      const Json& uid = it->value("sop_instance_uid_sha256", Json());
+      if (!window.is_array() || window.size() != 2 || !window[0].is_number() ||
+          !window[1].is_number() || !(window[1].get<double>() > 0) || !uid.is_string() ||
+          uid.get<std::string>().size() != 64) {
+        throw IoError(source, where +
+                                  ": 'window' must be [centre, width > 0] beside a 64-digit "
+                                  "'sop_instance_uid_sha256'");
+      }
+      pair.origins[file.image] = {window[0].get<double>(), window[1].get<double>(),
+                                  uid.get<std::string>()};
+    }
   }
   return pair;
 }

@@ -19,9 +19,22 @@
 
 namespace mmm::image {
 
+// Where an image came from, when not from a PNG: a DICOM radiograph's
+// display window and the hash of its SOP Instance UID (never the UID), so
+// that an auditor can match the images used with the originals.
+struct ImageOrigin {
+  double window_centre = 0.0;  // in the PNG's 16-bit units
+  double window_width = 0.0;   // > 0
+  std::string sop_instance_uid_sha256;
+  friend bool operator==(const ImageOrigin&, const ImageOrigin&) = default;
+};
+
 struct RadiographPair {
   std::vector<RadiographFile> views;
   std::map<std::string, std::string> images;  // image name -> PNG file bytes
+  // Image name -> origin, for the images read from DICOM (serialised as
+  // "window": [centre, width] and "sop_instance_uid_sha256" beside the PNG).
+  std::map<std::string, ImageOrigin> origins;
 
   // The view called `name`; throws InvalidInputError listing the names.
   [[nodiscard]] const RadiographFile& view(const std::string& name) const;

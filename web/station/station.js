@@ -262,7 +262,13 @@
       for (let k = 0; k < w * h; k++) this.samples[k] = data.getUint16(2 * k, true);
       this.imageWidth = w; this.imageHeight = h;
       this.bitmap.width = w; this.bitmap.height = h;
-      this.autoWindow();
+      if (this.spec.dicom && this.spec.dicom.window) {
+        // The radiograph's own window (DICOM Window Center / Width).
+        this.level.value = Math.round(this.spec.dicom.window[0]);
+        this.width.value = Math.max(1, Math.round(this.spec.dicom.window[1]));
+      } else {
+        this.autoWindow();
+      }
       this.node.querySelector(".loading").hidden = true;
       this.ready = true;
       this.resize();

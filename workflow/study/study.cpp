@@ -16,6 +16,7 @@
 
 #include "core/directory_bundle.h"
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "core/suggest.h"
 #include "workflow/definition/workflow_loader.h"
 #include "workflow/host_and_time.h"
@@ -92,14 +93,23 @@ std::string input_value_hint(PortType type) {
 // Stores the content of an input's origin: a file's bytes, or a folder's
 // bundle. Returns the artifact hash.
 std::string store_origin(ArtifactStore& artifacts, const std::filesystem::path& origin,
-                         const FileStamp& stamp) {
+                         const FileStamp& stamp, const NodeRegistry& registry) {
   if (stamp.size > kMaxStudyInputBytes) {
     throw IoError(origin, std::string(stamp.is_directory ? "holds " : "is ") +
                               std::to_string(stamp.size) + " bytes; a study input is at most " +
                               std::to_string(kMaxStudyInputBytes) +
                               " (1 GiB); hint: check that this is the file you meant");
   }
-  return stamp.is_directory ? artifacts.put(pack_directory(origin)) : artifacts.put_file(origin);
+  if (stamp.is_directory) return artifacts.put(pack_directory(origin));
+  // A file of a kind that must not be stored as given (e.g. DICOM, with the
+  // patient's identity in it) is stored as its importer converts it.
+  const auto size = static_cast<std::uintmax_t>(stamp.size);
+  const std::string head =
+      read_file_bytes(origin, std::min<std::uintmax_t>(size, kImporterHeadBytes));
+  if (const FileImporter* importer = registry.importer_for(head)) {
+    return artifacts.put(importer->convert(read_file_bytes(origin, size), origin));
+  }
+  return artifacts.put_file(origin);
 }
 
 std::string diagnostics_text(const LoadResult& result) {
@@ -370,7 +380,7 @@ StudyInputRecord Study::import_input(const StudyInput& declared, std::string_vie
   record.given = origin.string();
   record.source_size = stamp->size;
   record.source_mtime_ns = stamp->mtime_ns;
-  record.hash = store_origin(artifacts_, origin, *stamp);
+  record.hash = store_origin(artifacts_, origin, *stamp, *registry_);
   return record;
 }
 
@@ -419,7 +429,7 @@ std::vector<std::string> Study::refresh_file_inputs() {
     StudyInputRecord updated = record;
     updated.source_size = stamp->size;
     updated.source_mtime_ns = stamp->mtime_ns;
-    updated.hash = store_origin(artifacts_, record.given, *stamp);
+    updated.hash = store_origin(artifacts_, record.given, *stamp, *registry_);
     if (updated.hash != record.hash) {
       updated.updated_at = utc_now();
       changes.push_back("study input '" + name + "' changed: " + record.given +
