@@ -126,7 +126,7 @@ void write_accuracy_table() {
   for (int i = -4; i <= 4; ++i) {
     for (int j = -4; j <= 4; ++j) {
       for (int k = -16; k <= 16; ++k) {
-        points.push_back(options.isocentre_mm + Eigen::Vector3d(25 * i, 25 * j, 50 * k));
+        points.emplace_back(options.isocentre_mm + Eigen::Vector3d(25 * i, 25 * j, 50 * k));
       }
     }
   }
@@ -140,6 +140,7 @@ void write_accuracy_table() {
        << "view      | height from centre (mm) | mean  | max\n";
   for (const mmm::image::RadiographView& view : views) {
     std::vector<Eigen::Vector2d> pixels;
+    pixels.reserve(points.size());
     for (const Eigen::Vector3d& X : points) pixels.push_back(mmm::image::project(view, X));
     const mmm::image::RadiographView pinhole = mmm::image::fit_pinhole_view(
         points, pixels, view.name, view.width, view.height, view.pixel_spacing_mm);

@@ -112,7 +112,7 @@ class Fields {
   // Throws for a field none of the readers above asked for.
   void check_no_others() const {
     for (const auto& item : object_.items()) {
-      if (seen_.count(item.key()) == 0) {
+      if (!seen_.contains(item.key())) {
         fail(item.key(), "is not a field of a " + std::string(kDeidentifiedFormat) + " document");
       }
     }
@@ -207,7 +207,7 @@ DicomRadiograph deidentified_radiograph_from_text(std::string_view text, const f
   out.photometric_interpretation = fields.text("photometric_interpretation");
   if (out.photometric_interpretation != "MONOCHROME1" &&
       out.photometric_interpretation != "MONOCHROME2") {
-    fields.fail("photometric_interpretation", "must be \"MONOCHROME1\" or \"MONOCHROME2\"");
+    fields.fail("photometric_interpretation", R"(must be "MONOCHROME1" or "MONOCHROME2")");
   }
   out.bits_stored = fields.integer("bits_stored", 8, 16);
   out.pixel_signed = fields.flag("pixel_signed");
@@ -239,7 +239,7 @@ DicomRadiograph deidentified_radiograph_from_text(std::string_view text, const f
   } else if (window_source == "percentiles") {
     out.window.source = DicomWindowSource::kPercentiles;
   } else {
-    window.fail("source", "must be \"file\" or \"percentiles\"");
+    window.fail("source", R"(must be "file" or "percentiles")");
   }
   window.check_no_others();
 
@@ -255,7 +255,7 @@ DicomRadiograph deidentified_radiograph_from_text(std::string_view text, const f
         !is_orientation_letters((*orientation)[0].get<std::string>()) ||
         !is_orientation_letters((*orientation)[1].get<std::string>())) {
       fields.fail("patient_orientation",
-                  "must be two directions made of A, P, R, L, H, F, e.g. [\"L\", \"F\"]");
+                  R"(must be two directions made of A, P, R, L, H, F, e.g. ["L", "F"])");
     }
     out.patient_orientation = {(*orientation)[0].get<std::string>(),
                                (*orientation)[1].get<std::string>()};
@@ -263,7 +263,7 @@ DicomRadiograph deidentified_radiograph_from_text(std::string_view text, const f
   out.image_laterality = fields.optional_text("image_laterality");
   if (out.image_laterality && *out.image_laterality != "R" && *out.image_laterality != "L" &&
       *out.image_laterality != "U" && *out.image_laterality != "B") {
-    fields.fail("image_laterality", "must be \"R\", \"L\", \"U\" or \"B\"");
+    fields.fail("image_laterality", R"(must be "R", "L", "U" or "B")");
   }
   out.pixel_spacing_calibration_type = fields.optional_text("pixel_spacing_calibration_type");
 

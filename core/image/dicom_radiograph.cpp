@@ -134,15 +134,15 @@ class ByteViewBuffer : public std::streambuf {
   }
   pos_type seekoff(off_type offset, std::ios_base::seekdir direction,
                    std::ios_base::openmode which) override {
-    if ((which & std::ios_base::in) == 0) return pos_type(off_type(-1));
+    if ((which & std::ios_base::in) == 0) return {off_type(-1)};
     const off_type size = egptr() - eback();
     off_type base = 0;
     if (direction == std::ios_base::cur) base = gptr() - eback();
     if (direction == std::ios_base::end) base = size;
     const off_type target = base + offset;
-    if (target < 0 || target > size) return pos_type(off_type(-1));
+    if (target < 0 || target > size) return {off_type(-1)};
     setg(eback(), eback() + target, egptr());
-    return pos_type(target);
+    return {target};
   }
   pos_type seekpos(pos_type position, std::ios_base::openmode which) override {
     return seekoff(off_type(position), std::ios_base::beg, which);
@@ -430,7 +430,7 @@ std::int32_t stored_sample(const std::vector<char>& raw, std::size_t i, const Pi
     std::memcpy(&word, raw.data() + 2 * i, 2);  // GDCM decodes to host byte order
     bits = word;
   }
-  const std::uint32_t width = static_cast<std::uint32_t>(layout.bits_stored);
+  const auto width = static_cast<std::uint32_t>(layout.bits_stored);
   bits &= (std::uint32_t{1} << width) - 1U;
   auto value = static_cast<std::int32_t>(bits);
   if (layout.is_signed && (bits >> (width - 1U)) != 0U) {

@@ -5,6 +5,7 @@
 
 #include <gdcmTransferSyntax.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -34,8 +35,9 @@ std::string tag_text(std::uint16_t group, std::uint16_t element) {
   std::string out = "(gggg,eeee)";
   for (int i = 0; i < 4; ++i) {
     const auto shift = static_cast<unsigned>(12 - 4 * i);
-    out[static_cast<std::size_t>(1 + i)] = kDigits[(group >> shift) & 0xFU];
-    out[static_cast<std::size_t>(6 + i)] = kDigits[(element >> shift) & 0xFU];
+    const auto at = static_cast<std::size_t>(i);
+    out[1 + at] = kDigits[(group >> shift) & 0xFU];
+    out[6 + at] = kDigits[(element >> shift) & 0xFU];
   }
   if (group == 0x7FE0 && element == 0x0010) return "Pixel Data " + out;
   return "the element " + out;
@@ -50,10 +52,7 @@ constexpr std::array<std::string_view, 21> kShortVrs = {"AE", "AS", "AT", "CS", 
                                                         "SL", "SS", "ST", "TM", "UI", "UL", "US"};
 
 bool contains(const auto& list, std::string_view vr) {
-  for (const std::string_view item : list) {
-    if (item == vr) return true;
-  }
-  return false;
+  return std::ranges::any_of(list, [vr](std::string_view item) { return item == vr; });
 }
 
 class Walker {

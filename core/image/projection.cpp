@@ -203,7 +203,7 @@ class SidecarReader {
           model->is_string() ? projection_model_from_name(model->get<std::string>()) : std::nullopt;
       if (!known) {
         fail(where,
-             "field 'model' must be \"pinhole\" or \"slot-scanning\", got " + describe(*model));
+             R"(field 'model' must be "pinhole" or "slot-scanning", got )" + describe(*model));
       }
       file.view.model = *known;
     }

@@ -22,7 +22,7 @@ inline constexpr int kHeight = 48;
 // The folder of the fixtures; fails the test (never skips) when missing.
 inline std::filesystem::path fixture(const std::string& name) {
   const std::filesystem::path dir = binary_dir() / "fixtures" / "dicom";
-  const std::filesystem::path path = dir / name;
+  std::filesystem::path path = dir / name;
   if (!std::filesystem::exists(path)) {
     ADD_FAILURE() << path << " is missing: build the mmm_dicom_fixtures target (part of "
                   << "mmm_core_tests; it needs python3-pydicom)";

@@ -50,7 +50,7 @@ GrayImage16 expected_image(const std::function<double(int, int)>& value, const D
 DicomWindow sorted_percentile_window(const GrayImage16& image) {
   std::vector<std::uint16_t> sorted = image.pixels;
   std::sort(sorted.begin(), sorted.end());
-  const double last = static_cast<double>(sorted.size() - 1);
+  const auto last = static_cast<double>(sorted.size() - 1);
   const double low = sorted[static_cast<std::size_t>(std::floor(0.005 * last))];
   const double high = sorted[static_cast<std::size_t>(std::ceil(0.995 * last))];
   return {(low + high) / 2.0, high - low, DicomWindowSource::kPercentiles};
@@ -322,7 +322,8 @@ std::vector<std::uint16_t> gdcm_test_pixels(const GdcmImageSpec& spec) {
   for (int y = 0; y < spec.height; ++y) {
     for (int x = 0; x < spec.width; ++x) {
       // Full 0..65535 range (identity map) with structure in every bit.
-      pixels[static_cast<std::size_t>(y * spec.width + x)] =
+      pixels[static_cast<std::size_t>(y) * static_cast<std::size_t>(spec.width) +
+             static_cast<std::size_t>(x)] =
           static_cast<std::uint16_t>((x * 1777 + y * 4099) % 65536);
     }
   }

@@ -186,11 +186,12 @@ TEST(SlotScanningTest, APinholeFittedToAFullLegScanIsMillimetresOff) {
   for (int i = -4; i <= 4; ++i) {
     for (int j = -4; j <= 4; ++j) {
       for (int k = -8; k <= 8; ++k)
-        points.push_back(iso + Eigen::Vector3d(25 * i, 25 * j, 100 * k));
+        points.emplace_back(iso + Eigen::Vector3d(25 * i, 25 * j, 100 * k));
     }
   }
   for (const RadiographView& view : views) {
     std::vector<Eigen::Vector2d> pixels;
+    pixels.reserve(points.size());
     for (const Eigen::Vector3d& X : points) pixels.push_back(project(view, X));
     const RadiographView pinhole =
         fit_pinhole_view(points, pixels, view.name, view.width, view.height, view.pixel_spacing_mm);
