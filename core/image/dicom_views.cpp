@@ -102,33 +102,19 @@ RadiographView view_of(const NamedDicom& file, const std::string& name, bool fro
          "Pixel Spacing (0028,0030) calibrated to the patient): " +
              spacing.explanation);
   }
-  const double row_spacing = (*detector)[0];
-  const double column_spacing = (*detector)[1];
-  const int width = dicom.columns;
-  const int height = dicom.rows;
-
-  RadiographView view;
-  view.name = name;
-  view.model = model;
-  view.width = width;
-  view.height = height;
-  view.pixel_spacing_mm = column_spacing * sod / sid;
-  const Eigen::Vector3d source = -sod * axes.beam;
-  Eigen::Matrix3d R;
-  R.row(0) = u_axis.transpose();
-  R.row(1) = v_axis.transpose();
-  R.row(2) = axes.beam.transpose();
-  Eigen::Matrix3d K;
-  K << sid / column_spacing, 0, 0.5 * width, 0, sid / row_spacing, 0.5 * height, 0, 0, 1;
-  view.P.leftCols<3>() = K * R;
-  view.P.col(3) = -K * R * source;
-  if (model == ProjectionModel::kSlotScanning) {
-    // The scan step: the rows' spacing at the patient plane.
-    const double step = row_spacing * sod / sid;
-    view.P.block<1, 3>(1, 0) = v_axis.transpose() / step;
-    view.P(1, 3) = 0.5 * height;
-  }
-  view.source_mm = -view.P.leftCols<3>().partialPivLu().solve(view.P.col(3));
+  ViewGeometry geometry;
+  geometry.name = name;
+  geometry.u_axis = u_axis;
+  geometry.v_axis = v_axis;
+  geometry.beam = axes.beam;
+  geometry.source_to_isocentre_mm = sod;
+  geometry.source_to_detector_mm = sid;
+  geometry.column_pitch_mm = (*detector)[1];
+  geometry.row_pitch_mm = (*detector)[0];
+  geometry.width = dicom.columns;
+  geometry.height = dicom.rows;
+  geometry.model = model;
+  RadiographView view = make_view(geometry);
   validate_view(view);
   return view;
 }

@@ -59,41 +59,6 @@ void check_positive(double value, const char* field) {
   }
 }
 
-// A view looking along `beam` from isocentre - source_to_isocentre * beam,
-// image axes u_axis (right) and v_axis (down); u_axis x v_axis = beam.
-RadiographView make_view(const BiplanarOptions& options, const std::string& name,
-                         const Eigen::Vector3d& u_axis, const Eigen::Vector3d& v_axis,
-                         const Eigen::Vector3d& beam, int width, int height) {
-  const double sid = options.source_to_isocentre_mm;
-  const double sdd = options.source_to_detector_mm;
-  RadiographView view;
-  view.name = name;
-  view.width = width;
-  view.height = height;
-  view.pixel_spacing_mm = options.detector_pixel_pitch_mm * sid / sdd;
-  view.source_mm = options.isocentre_mm - sid * beam;
-  Eigen::Matrix3d R;
-  R.row(0) = u_axis.transpose();
-  R.row(1) = v_axis.transpose();
-  R.row(2) = beam.transpose();
-  // Focal length in pixels: the detector distance over the detector pitch
-  // (equivalently the isocentre distance over the spacing at the isocentre).
-  const double focal = sdd / options.detector_pixel_pitch_mm;
-  Eigen::Matrix3d K;
-  K << focal, 0, 0.5 * width, 0, focal, 0.5 * height, 0, 0, 1;
-  view.P.leftCols<3>() = K * R;
-  view.P.col(3) = -K * R * view.source_mm;
-  if (options.model == ProjectionModel::kSlotScanning) {
-    // Row v is the height over the scan step (the spacing at the isocentre,
-    // so that pixels are square there), centred like the pinhole's.
-    view.model = ProjectionModel::kSlotScanning;
-    view.P.block<1, 3>(1, 0) = v_axis.transpose() / view.pixel_spacing_mm;
-    view.P(1, 3) = 0.5 * height - v_axis.dot(options.isocentre_mm) / view.pixel_spacing_mm;
-    view.source_mm = -view.P.leftCols<3>().partialPivLu().solve(view.P.col(3));
-  }
-  return view;
-}
-
 // --- sidecar reading ---
 
 class SidecarReader {
@@ -299,6 +264,37 @@ class SidecarReader {
 
 }  // namespace
 
+RadiographView make_view(const ViewGeometry& g) {
+  const double sid = g.source_to_isocentre_mm;
+  const double sdd = g.source_to_detector_mm;
+  RadiographView view;
+  view.name = g.name;
+  view.model = g.model;
+  view.width = g.width;
+  view.height = g.height;
+  view.pixel_spacing_mm = g.column_pitch_mm * sid / sdd;
+  const Eigen::Vector3d source = g.isocentre_mm - sid * g.beam;
+  Eigen::Matrix3d R;
+  R.row(0) = g.u_axis.transpose();
+  R.row(1) = g.v_axis.transpose();
+  R.row(2) = g.beam.transpose();
+  // Focal lengths in pixels: the detector distance over the detector pitch
+  // (equivalently the isocentre distance over the spacing at the isocentre).
+  Eigen::Matrix3d K;
+  K << sdd / g.column_pitch_mm, 0, 0.5 * g.width, 0, sdd / g.row_pitch_mm, 0.5 * g.height, 0, 0, 1;
+  view.P.leftCols<3>() = K * R;
+  view.P.col(3) = -K * R * source;
+  if (g.model == ProjectionModel::kSlotScanning) {
+    // Row v is the height over the scan step (the rows' spacing at the
+    // isocentre), the isocentre on the middle row.
+    const double step = g.row_pitch_mm * sid / sdd;
+    view.P.block<1, 3>(1, 0) = g.v_axis.transpose() / step;
+    view.P(1, 3) = 0.5 * g.height - g.v_axis.dot(g.isocentre_mm) / step;
+  }
+  view.source_mm = -view.P.leftCols<3>().partialPivLu().solve(view.P.col(3));
+  return view;
+}
+
 std::array<RadiographView, 2> make_biplanar_views(const BiplanarOptions& options) {
   if (!options.isocentre_mm.allFinite()) {
     throw InvalidInputError("BiplanarOptions.isocentre_mm must be finite, got " +
@@ -324,15 +320,26 @@ std::array<RadiographView, 2> make_biplanar_views(const BiplanarOptions& options
                             std::to_string(height) +
                             " pixels (limit 100000 a side): check field_*_mm and the pitch");
   }
-  const int w = static_cast<int>(width);
-  const int h = static_cast<int>(height);
-  const Eigen::Vector3d down(0, 0, -1);
+  ViewGeometry geometry;
+  geometry.isocentre_mm = options.isocentre_mm;
+  geometry.v_axis = Eigen::Vector3d(0, 0, -1);
+  geometry.source_to_isocentre_mm = options.source_to_isocentre_mm;
+  geometry.source_to_detector_mm = options.source_to_detector_mm;
+  geometry.column_pitch_mm = options.detector_pixel_pitch_mm;
+  geometry.row_pitch_mm = options.detector_pixel_pitch_mm;
+  geometry.width = static_cast<int>(width);
+  geometry.height = static_cast<int>(height);
+  geometry.model = options.model;
   // Frontal: beam -y (AP), u toward the subject's left (-x).
-  RadiographView frontal = make_view(options, "frontal", Eigen::Vector3d(-1, 0, 0), down,
-                                     Eigen::Vector3d(0, -1, 0), w, h);
+  geometry.name = "frontal";
+  geometry.u_axis = Eigen::Vector3d(-1, 0, 0);
+  geometry.beam = Eigen::Vector3d(0, -1, 0);
+  RadiographView frontal = make_view(geometry);
   // Lateral: beam -x (right to left), u toward anterior (+y).
-  RadiographView lateral = make_view(options, "lateral", Eigen::Vector3d(0, 1, 0), down,
-                                     Eigen::Vector3d(-1, 0, 0), w, h);
+  geometry.name = "lateral";
+  geometry.u_axis = Eigen::Vector3d(0, 1, 0);
+  geometry.beam = Eigen::Vector3d(-1, 0, 0);
+  RadiographView lateral = make_view(geometry);
   return {std::move(frontal), std::move(lateral)};
 }
 

@@ -117,6 +117,29 @@ struct BiplanarOptions {
   ProjectionModel model = ProjectionModel::kPinhole;
 };
 
+// One view of a radiography system in the world frame: its isocentre, its
+// image axes (u right, v down) and beam (unit, u x v = beam: the image seen
+// from the source), distances and detector pitch per axis.
+struct ViewGeometry {
+  std::string name;
+  Eigen::Vector3d isocentre_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d u_axis = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d v_axis = -Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d beam = -Eigen::Vector3d::UnitY();
+  double source_to_isocentre_mm = 1300.0;
+  double source_to_detector_mm = 1700.0;
+  double column_pitch_mm = 0.3;  // detector plane
+  double row_pitch_mm = 0.3;
+  int width = 1;
+  int height = 1;
+  ProjectionModel model = ProjectionModel::kPinhole;
+};
+
+// The view of `geometry`: the isocentre at the image centre; for a
+// slot-scanning view the rows' spacing at the isocentre is the scan step.
+// The caller checks the values (make_biplanar_views, views_from_dicom).
+RadiographView make_view(const ViewGeometry& geometry);
+
 // The calibrated pair {frontal, lateral} described by `options` (names
 // "frontal" and "lateral"). The isocentre projects to the image centre
 // (width / 2, height / 2) of both. Throws InvalidInputError naming the field
