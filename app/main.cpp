@@ -25,6 +25,7 @@ int run(int argc, char** argv) {
   mmm::app::register_atlas_commands(app);
   mmm::app::register_patient_commands(app);
   mmm::app::register_overlay_commands(app);
+  mmm::app::register_calibrate_commands(app);
   const mmm::workflow::NodeRegistry registry = mmm::nodes::make_node_registry();
   mmm::app::register_workflow_commands(app, registry);
   mmm::app::register_study_commands(app, registry);

@@ -25,6 +25,9 @@ void register_patient_commands(CLI::App& app);
 // mmm overlay: atlas bones outlined over a radiograph pair
 void register_overlay_commands(CLI::App& app);
 
+// mmm calibrate: a pair's calibration from a calibration object (beads)
+void register_calibrate_commands(CLI::App& app);
+
 // mmm study create|set, mmm run, mmm status, mmm explain
 void register_study_commands(CLI::App& app, const workflow::NodeRegistry& registry);
 
