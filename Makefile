@@ -34,10 +34,13 @@ SANITIZER_PACKAGES := clang libclang-rt-14-dev
 # station, a clearly labelled scripted operator placing the landmarks (noisy
 # clicks from the patient's ground truth), then scaling, motion, wrapping and
 # fibres. MANUAL=1 leaves the landmark task open for a person instead.
+# DICOM=1 gives the study the patient's radiographs as DICOM files (with an
+# invented identity, removed when the study is created) instead of PNGs.
 # Interrupt it at any point and run it again: it goes on where it stopped.
 MANUAL ?= 0
+DICOM ?= 0
 demo: build-mmm $(ATLAS_DIR)/atlas.yaml
-	./cmake/demo.sh $(BUILD_DIR)/bin/mmm $(ATLAS_DIR) $(DATA_DIR) $(BUILD_DIR)/demo $(JOBS) $(MANUAL)
+	DICOM=$(DICOM) ./cmake/demo.sh $(BUILD_DIR)/bin/mmm $(ATLAS_DIR) $(DATA_DIR) $(BUILD_DIR)/demo $(JOBS) $(MANUAL)
 
 # The default atlas: rebuilt when missing or when its recipe changes.
 $(ATLAS_DIR)/atlas.yaml: $(RECIPE) | build-mmm

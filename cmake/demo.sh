@@ -6,18 +6,23 @@
 #   demo.sh MMM ATLAS_DIR DATA_DIR DEMO_DIR JOBS MANUAL [NODE.PARAM=VALUE ...]
 # The optional settings change the study's parameters (mmm study set) before
 # it runs; the end-to-end test (tests/e2e) walks a shorter part of the trial.
+# DICOM=1 in the environment: the patient's radiographs are also written as
+# DICOM files (with an invented identity) and the study is given those, with
+# the same calibration (patient_1_dicom, studies/patient_1_dicom).
 set -euo pipefail
 mmm=$1 atlas=$2 data=$3 demo=$4 jobs=$5 manual=${6:-0}
 settings=("${@:7}")
-patient=$demo/patient_1
+suffix="" image=png synth_flags=()
+if [[ "${DICOM:-0}" == 1 ]]; then suffix=_dicom image=dcm synth_flags=(--dicom); fi
+patient=$demo/patient_1$suffix
 root=$demo/studies
-study=$root/patient_1
+study=$root/patient_1$suffix
 operator=scripted-operator
 stage() { echo "== mmm demo: $* =="; }
 
 stage "synthetic patient 1: a deformed atlas (the truth) and its calibrated frontal/lateral radiographs"
 if [[ ! -f $patient/ground_truth.json ]]; then
-  "$mmm" patient synth --atlas "$atlas" --seed 1 -o "$patient"
+  "$mmm" patient synth --atlas "$atlas" --seed 1 -o "$patient" "${synth_flags[@]}"
 fi
 
 stage "the default study ($study)"
@@ -27,8 +32,8 @@ if [[ ! -f $study/study.db ]]; then
   "$mmm" study create "$study" -w workflows/default.yaml \
     --input atlas="$atlas" \
     --input calibration="$patient/radiographs/views.json" \
-    --input frontal="$patient/radiographs/frontal.png" \
-    --input lateral="$patient/radiographs/lateral.png" --input patient=P001 \
+    --input frontal="$patient/radiographs/frontal.$image" \
+    --input lateral="$patient/radiographs/lateral.$image" --input patient=P001 \
     --input model="$data/gait2392/Pipelines/reference/subject01_simbody.osim" \
     --input trial="$data/gait2392/Pipelines/subject01_walk1.trc"
 fi
@@ -49,9 +54,9 @@ if [[ $code -eq 3 ]]; then
   task=$("$mmm" worklist --root "$root" --json | python3 -c '
 import json, sys
 for t in json.load(sys.stdin):
-    if t["study"] == "patient_1" and t["node"] == "landmarks" and t["state"] in ("open", "claimed"):
+    if t["study"] == sys.argv[1] and t["node"] == "landmarks" and t["state"] in ("open", "claimed"):
         print(t["task"], t["state"], t["assignee"])
-        break')
+        break' "patient_1$suffix")
   read -r id state assignee <<<"$task"
   if [[ $manual == 1 ]]; then
     cat <<EOT

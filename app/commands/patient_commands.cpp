@@ -31,12 +31,16 @@ struct SynthArgs {
   bool local_shape = false;
   bool muscles_in_air = false;
   bool pinhole = false;
+  bool dicom = false;
   bool json = false;
 };
 
 constexpr const char* kMusclesInAirHelp =
     "Render the muscles as soft tissue standing in air, bone on top, rather than the limb filled "
     "with soft tissue that the bones replace (the default, as in a real radiograph)";
+constexpr const char* kDicomHelp =
+    "Also write each radiograph as a DICOM file (radiographs/<view>.dcm: DX with its geometry "
+    "attributes and an invented patient identity, which a study removes)";
 constexpr const char* kPinholeHelp =
     "Render two conventional (pinhole) radiographs rather than an EOS-type slot scan, conic "
     "across the leg and parallel along it (the default)";
@@ -53,6 +57,7 @@ void run_synth(const SynthArgs& args) {
   options.deformation.local_shape = args.local_shape;
   options.soft_tissue_envelope = !args.muscles_in_air;
   options.model = projection_model(args.pinhole);
+  options.write_dicom = args.dicom;
   const atlas::SyntheticPatientReport report =
       atlas::make_synthetic_patient(args.atlas, args.out, options);
   if (args.json) {
@@ -98,6 +103,7 @@ struct BonesArgs {
   bool local_shape = false;
   bool muscles_in_air = false;
   bool pinhole = false;
+  bool dicom = false;
 };
 
 void print_bone_patient(const atlas::BoneSetPatientReport& report, const std::string& out) {
@@ -124,6 +130,7 @@ atlas::PatientRadiographOptions radiograph_options(const BonesArgs& args) {
   options.seed = args.seed;
   options.soft_tissue_envelope = !args.muscles_in_air;
   options.model = projection_model(args.pinhole);
+  options.write_dicom = args.dicom;
   return options;
 }
 
@@ -202,6 +209,7 @@ void register_patient_commands(CLI::App& app) {
                   "map of the atlas produces");
   synth->add_flag("--muscles-in-air", args->muscles_in_air, kMusclesInAirHelp);
   synth->add_flag("--pinhole", args->pinhole, kPinholeHelp);
+  synth->add_flag("--dicom", args->dicom, kDicomHelp);
   synth->add_flag("--json", args->json, "Print the drawn factors as JSON");
   synth->callback([args] { run_synth(*args); });
 
@@ -221,6 +229,7 @@ void register_patient_commands(CLI::App& app) {
       ->check(CLI::Range(0.05, 2.0));
   from_bones->add_flag("--muscles-in-air", bones->muscles_in_air, kMusclesInAirHelp);
   from_bones->add_flag("--pinhole", bones->pinhole, kPinholeHelp);
+  from_bones->add_flag("--dicom", bones->dicom, kDicomHelp);
   from_bones->callback([bones] { run_from_bones(*bones); });
 
   auto foreign = std::make_shared<BonesArgs>();
@@ -241,6 +250,7 @@ void register_patient_commands(CLI::App& app) {
       ->check(CLI::Range(0.05, 2.0));
   foreign_command->add_flag("--muscles-in-air", foreign->muscles_in_air, kMusclesInAirHelp);
   foreign_command->add_flag("--pinhole", foreign->pinhole, kPinholeHelp);
+  foreign_command->add_flag("--dicom", foreign->dicom, kDicomHelp);
   foreign_command->callback([foreign] { run_foreign(*foreign); });
 
   auto clicks = std::make_shared<ClickArgs>();

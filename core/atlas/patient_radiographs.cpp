@@ -6,6 +6,8 @@
 
 #include "core/atlas/limb_envelope.h"
 #include "core/errors.h"
+#include "core/file_bytes.h"
+#include "core/image/dicom_write.h"
 #include "core/image/mesh_render.h"
 #include "core/image/png.h"
 #include "core/mesh/aabb_tree.h"
@@ -40,6 +42,36 @@ image::RgbImage8 half_size_rgb(const image::GrayImage8& picture) {
     }
   }
   return half;
+}
+
+// <view>.dcm beside the PNG: the same samples, the system's geometry, and an
+// invented identity (a study given it must drop that).
+void write_dicom(const image::GrayImage16& picture, const image::RadiographView& view,
+                 std::size_t k, const PatientRadiographOptions& options,
+                 const std::filesystem::path& dir) {
+  image::DicomExport dicom;
+  const bool frontal = view.name == "frontal";
+  dicom.view_position = frontal ? "AP" : "LL";
+  dicom.patient_orientation =
+      frontal ? std::array<std::string, 2>{"L", "F"} : std::array<std::string, 2>{"A", "F"};
+  dicom.row_pitch_mm = options.detector_pixel_pitch_mm;
+  dicom.column_pitch_mm = options.detector_pixel_pitch_mm;
+  dicom.source_to_detector_mm = options.source_to_detector_mm;
+  dicom.source_to_patient_mm = options.source_to_isocentre_mm;
+  std::vector<std::uint16_t> sorted = picture.pixels;
+  std::ranges::sort(sorted);
+  const double low = sorted[sorted.size() / 200];
+  const double high = std::max(low + 1.0, static_cast<double>(sorted[sorted.size() * 199 / 200]));
+  dicom.window_centre = 0.5 * (low + high);
+  dicom.window_width = high - low;
+  const std::string seed = std::to_string(options.seed);
+  dicom.patient_name = "SYNTHETIC^PATIENT^" + seed;
+  dicom.patient_id = "SYN-" + seed;
+  dicom.patient_birth_date = "19700101";
+  dicom.study_date = "20260101";
+  // A UUID-derived OID (2.25.<integer>, PS3.5 B.2) made from the seed.
+  dicom.sop_instance_uid = "2.25." + std::to_string(options.seed * 10 + k + 1);
+  write_file_atomically(dir / (view.name + ".dcm"), image::dicom_radiograph_bytes(picture, dicom));
 }
 
 }  // namespace
@@ -103,6 +135,7 @@ std::array<image::RadiographView, 2> write_patient_radiographs(
     const image::GrayImage16 picture = image::to_radiograph(integrals, radiograph);
     const std::string file = views[k].name + ".png";
     image::write_png(picture, dir / file);
+    if (options.write_dicom) write_dicom(picture, views[k], k, options, dir);
     const image::GrayImage8 windowed = preview(picture);
     image::write_png(windowed, dir / (views[k].name + "_preview.png"));
     halves.push_back(half_size_rgb(windowed));

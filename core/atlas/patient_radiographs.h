@@ -33,6 +33,9 @@ struct PatientRadiographOptions {
   // Slot-scanning views (an EOS-type scan: conic across, parallel along the
   // leg) or pinhole views (two conventional radiographs).
   image::ProjectionModel model = image::ProjectionModel::kSlotScanning;
+  // Also write each view as a DICOM file (<view>.dcm: DX, the system's
+  // geometry attributes, an invented identity to be removed by a study).
+  bool write_dicom = false;
   double mu_bone_per_mm = image::kBoneMuPerMm;
   double mu_soft_per_mm = image::kSoftTissueMuPerMm;
   // Soft tissue as in a real limb: an envelope around bones and muscles

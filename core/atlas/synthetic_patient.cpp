@@ -133,6 +133,7 @@ SyntheticPatientReport make_synthetic_patient(const std::filesystem::path& atlas
   pictures.mu_soft_per_mm = options.mu_soft_per_mm;
   pictures.soft_tissue_envelope = options.soft_tissue_envelope;
   pictures.model = options.model;
+  pictures.write_dicom = options.write_dicom;
   pictures.radiograph = options.radiograph;
   pictures.seed = options.deformation.seed;
   pictures.threads = options.threads;
