@@ -1,6 +1,7 @@
 #include "core/image/dicom_views.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -126,9 +127,28 @@ DicomPairGeometry views_from_dicom(const NamedDicom& frontal, const NamedDicom& 
   if (frontal.radiograph == nullptr || lateral.radiograph == nullptr) {
     throw InvalidInputError("views_from_dicom: a radiograph is missing");
   }
+  if (frontal.radiograph->sop_instance_uid_sha256 == lateral.radiograph->sop_instance_uid_sha256) {
+    throw IoError(lateral.source, "is the same image as " + frontal.source.string() +
+                                      " (the same SOP Instance UID); hint: give the lateral view");
+  }
   DicomPairGeometry pair;
   pair.views[0] = view_of(frontal, "frontal", true, model, pair.mirrored[0]);
   pair.views[1] = view_of(lateral, "lateral", false, model, pair.mirrored[1]);
+  if (model == ProjectionModel::kSlotScanning) {
+    // One scan lights both views row by row: the same rows at the same step.
+    const double step0 = 1.0 / pair.views[0].P.block<1, 3>(1, 0).norm();
+    const double step1 = 1.0 / pair.views[1].P.block<1, 3>(1, 0).norm();
+    if (pair.views[0].height != pair.views[1].height ||
+        std::abs(step0 - step1) > 1e-3 * std::max(step0, step1)) {
+      throw IoError(lateral.source,
+                    "is inconsistent with " + frontal.source.string() +
+                        " for one slot scan: " + std::to_string(pair.views[1].height) +
+                        " rows of " + std::to_string(step1) + " mm against " +
+                        std::to_string(pair.views[0].height) + " rows of " + std::to_string(step0) +
+                        " mm (Rows, Imager Pixel Spacing, the distances); hint: check that both "
+                        "files come from the same acquisition, or use model 'pinhole'");
+    }
+  }
   return pair;
 }
 

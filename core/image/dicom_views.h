@@ -50,6 +50,8 @@ struct NamedDicom {
 // inconsistent: no SID or SOD, SOD >= SID, no usable spacing, a view position
 // that is not frontal (AP/PA) for the first or lateral (LL/RL/LATERAL) for
 // the second, axes that are not perpendicular to the beam and each other.
+// The same image twice (one SOP Instance UID) and, for a slot scan, views
+// whose rows differ in number or step (one scan lights both) are refused.
 // `mirrored[k]` says whether view k's image must be flipped left-right to be
 // seen from the source (mirror_columns does it).
 struct DicomPairGeometry {

@@ -139,6 +139,22 @@ TEST(LoadDicomRadiographsTest, IncompleteGeometryIsRefusedNamingTheAttribute) {
   }
 }
 
+TEST(LoadDicomRadiographsTest, AnInconsistentPairIsRefused) {
+  const auto reference = reference_views(image::ProjectionModel::kSlotScanning);
+  test::NodeHarness harness;
+  // The same image as both views.
+  const image::DicomRadiograph frontal = dicom_of(reference[0], "AP", 1);
+  image::DicomRadiograph copy = dicom_of(reference[1], "LL", 1);
+  copy.sop_instance_uid_sha256 = frontal.sop_instance_uid_sha256;
+  EXPECT_THAT([&] { run_node(harness, frontal, copy, "slot-scanning"); },
+              ::testing::ThrowsMessage<IoError>(HasSubstr("is the same image as")));
+  // A lateral view of another scan: other rows.
+  image::DicomRadiograph other = dicom_of(reference[1], "LL", 2);
+  other.imager_pixel_spacing = image::PixelSpacingMm{2 * kPitch, kPitch};
+  EXPECT_THAT([&] { run_node(harness, frontal, other, "slot-scanning"); },
+              ::testing::ThrowsMessage<IoError>(HasSubstr("for one slot scan")));
+}
+
 // Every file of a folder, read whole, concatenated.
 std::string folder_bytes(const std::filesystem::path& dir) {
   std::string all;
