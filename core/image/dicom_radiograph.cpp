@@ -609,6 +609,11 @@ DicomRadiograph read_dicom_radiograph(std::string_view bytes, const fs::path& so
   const double value_min = std::min(value_a, value_b);
   const double value_range = std::max(value_a, value_b) - value_min;
   out.value_map = {value_min, value_range > 0.0 ? 65535.0 / value_range : 1.0, layout.monochrome1};
+  // Unsigned 16-bit samples without a rescale keep their values: the image
+  // is the file's, sample for sample, as a 16-bit PNG of it would be.
+  if (layout.bits_stored == 16 && !out.pixel_signed && slope == 1.0 && intercept == 0.0) {
+    out.value_map = {0.0, 1.0, layout.monochrome1};
+  }
 
   out.image = GrayImage16(layout.columns, layout.rows);
   const DicomValueMap& map = out.value_map;

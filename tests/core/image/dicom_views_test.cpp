@@ -44,11 +44,13 @@ TEST(DicomViewsTest, WrittenRadiographsCalibrateToTheSystemsViews) {
     for (std::size_t k = 0; k < 2; ++k) {
       GrayImage16 image(views[k].width, views[k].height);
       std::mt19937 rng(static_cast<unsigned>(k + 1));
-      for (std::uint16_t& sample : image.pixels) sample = static_cast<std::uint16_t>(rng());
-      image.pixels.front() = 0;
-      image.pixels.back() = 65535;  // the full range: the value map is the identity
-      const std::string bytes = dicom_radiograph_bytes(
-          image, k == 0 ? export_of("AP", {"L", "F"}) : export_of("LL", {"A", "F"}));
+      // Not the full range: unsigned 16-bit samples are kept as they are.
+      for (std::uint16_t& sample : image.pixels) {
+        sample = static_cast<std::uint16_t>(1000 + rng() % 50000);
+      }
+      DicomExport e = k == 0 ? export_of("AP", {"L", "F"}) : export_of("LL", {"A", "F"});
+      e.sop_instance_uid += std::to_string(k);
+      const std::string bytes = dicom_radiograph_bytes(image, e);
       read[k] = read_dicom_radiograph(bytes, "written.dcm");
       EXPECT_EQ(read[k].image.pixels, image.pixels);
       EXPECT_EQ(read[k].window.centre, 21000);
