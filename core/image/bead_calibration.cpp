@@ -24,9 +24,8 @@ struct BeadResidualCost {
   template <typename T>
   bool operator()(const T* const p, T* residual) const {
     std::array<T, 3> h;
-    for (int r = 0; r < 3; ++r) {
-      h[static_cast<std::size_t>(r)] =
-          p[4 * r] * X.x() + p[4 * r + 1] * X.y() + p[4 * r + 2] * X.z() + p[4 * r + 3];
+    for (std::size_t r = 0; r < 3; ++r) {
+      h[r] = p[4 * r] * X.x() + p[4 * r + 1] * X.y() + p[4 * r + 2] * X.z() + p[4 * r + 3];
     }
     if (ceres::abs(h[2]) < T(1e-12)) return false;
     residual[0] = (h[0] / h[2] - pixel.x()) * spacing;
@@ -171,10 +170,10 @@ BeadCalibration calibrate_view_from_beads(const std::string& name, int width, in
   finish(P);
   P = view.P;
 
+  // P's entries row by row, as the cost reads them.
+  using RowMajor34 = Eigen::Matrix<double, 3, 4, Eigen::RowMajor>;
   std::array<double, 12> p{};
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 4; ++c) p[static_cast<std::size_t>(4 * r + c)] = P(r, c);
-  }
+  Eigen::Map<RowMajor34>(p.data()) = P;
   ceres::Problem problem;
   for (const BeadPixel& bead : beads) {
     problem.AddResidualBlock(
@@ -195,9 +194,7 @@ BeadCalibration calibrate_view_from_beads(const std::string& name, int width, in
       summary.termination_type == ceres::USER_FAILURE) {
     throw SolverError("bead calibration of view '" + name + "': " + summary.BriefReport());
   }
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 4; ++c) P(r, c) = p[static_cast<std::size_t>(4 * r + c)];
-  }
+  P = Eigen::Map<const RowMajor34>(p.data());
   // Row 2 back to unit length (the pinhole's scale, the slot's u scale).
   const double norm = P.block<1, 3>(2, 0).norm();
   P.row(0) /= norm;

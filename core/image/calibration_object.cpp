@@ -78,7 +78,10 @@ BeadClicks parse_bead_clicks(std::string_view text, const std::filesystem::path&
       throw IoError(source, "views." + view + ": must be an object of bead name -> [u, v]");
     }
     for (const auto& [bead, pixel] : beads.items()) {
-      const std::string where = "views." + view + "." + bead;
+      std::string where = "views.";
+      where += view;
+      where += '.';
+      where += bead;
       if (!object.beads.contains(bead)) {
         throw IoError(source, where + ": unknown bead (the object has " +
                                   std::to_string(object.beads.size()) + " beads, " +

@@ -115,7 +115,9 @@ TEST(BeadCalibrationTest, TooFewOrFlatBeadsAreRefused) {
       ::testing::ThrowsMessage<InvalidInputError>(HasSubstr("given twice")));
   std::vector<BeadPixel> flat;
   for (int i = 0; i < 12; ++i) {
-    const Eigen::Vector3d X(5 + 20 * (i % 4), -10, 700 + 100 * (i / 4));
+    const int column = i % 4;
+    const int row = i / 4;
+    const Eigen::Vector3d X(5.0 + 20.0 * column, -10.0, 700.0 + 100.0 * row);
     flat.push_back({"f" + std::to_string(i), X, project(truth, X)});
   }
   EXPECT_THROW(calibrate_view_from_beads("frontal", truth.width, truth.height,

@@ -57,7 +57,7 @@ TEST(DicomViewsTest, WrittenRadiographsCalibrateToTheSystemsViews) {
       EXPECT_EQ(read[k].window.width, 9000);
     }
     const DicomPairGeometry geometry =
-        views_from_dicom({&read[0], "frontal.dcm"}, {&read[1], "lateral.dcm"}, model);
+        views_from_dicom({read.data(), "frontal.dcm"}, {read.data() + 1, "lateral.dcm"}, model);
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
     for (std::size_t k = 0; k < 2; ++k) {
