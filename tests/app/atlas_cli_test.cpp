@@ -21,6 +21,8 @@
 #include <variant>
 
 #include "core/atlas/atlas_io.h"
+#include "core/image/dicom_radiograph.h"
+#include "core/image/dicom_views.h"
 #include "core/image/png.h"
 #include "core/image/projection.h"
 #include "tests/support/test_data.h"
@@ -176,17 +178,25 @@ void AtlasCliTest::patient_radiographs_show_the_anatomy() {
   const std::filesystem::path patient = scratch_->path() / "patient";
   // A coarse detector (1.5 mm pitch) keeps the test quick.
   const CommandResult made = run_mmm("patient synth --atlas " + atlas_.string() +
-                                     " --seed 7 --pixel-pitch 1.5 -o " + patient.string());
+                                     " --seed 7 --pixel-pitch 1.5 --dicom -o " + patient.string());
   ASSERT_EQ(made.exit_code, 0) << made.err;
   const nlohmann::json truth =
       nlohmann::json::parse(mmm::test::read_text(patient / "ground_truth.json"));
   const auto views = image::read_view_sidecar(patient / "radiographs" / "views.json");
   ASSERT_EQ(views.size(), 2U);
+  std::vector<image::DicomRadiograph> dicoms;
+  dicoms.reserve(views.size());
   for (const image::RadiographFile& file : views) {
     SCOPED_TRACE(file.view.name);
     const image::GrayImage16 radiograph =
         image::read_png_gray16(patient / "radiographs" / file.image);
     ASSERT_EQ(radiograph.width, file.view.width);
+    // The DICOM copy: the same samples, and its attributes make the same
+    // slot-scanning view about the isocentre (the world origin for a view
+    // calibrated from DICOM, the bones' centre for the synthetic patient).
+    dicoms.push_back(
+        image::read_dicom_radiograph(patient / "radiographs" / (file.view.name + ".dcm")));
+    EXPECT_EQ(dicoms.back().image.pixels, radiograph.pixels);
     std::vector<std::uint16_t> sorted = radiograph.pixels;
     std::ranges::sort(sorted);
     const double median = sorted[sorted.size() / 2];
@@ -205,6 +215,22 @@ void AtlasCliTest::patient_radiographs_show_the_anatomy() {
       const int v = std::clamp(static_cast<int>(pixel.y()), 0, radiograph.height - 1);
       EXPECT_GT(radiograph.at(u, v), median + 2000) << name;
     }
+  }
+  const image::DicomPairGeometry from_dicom =
+      image::views_from_dicom({dicoms.data(), "frontal.dcm"}, {dicoms.data() + 1, "lateral.dcm"},
+                              image::ProjectionModel::kSlotScanning);
+  // The isocentre: the point both true views project to their image centres.
+  const std::array<image::RadiographView, 2> truth_views = {views[0].view, views[1].view};
+  const std::array<Eigen::Vector2d, 2> centres = {
+      Eigen::Vector2d(0.5 * views[0].view.width, 0.5 * views[0].view.height),
+      Eigen::Vector2d(0.5 * views[1].view.width, 0.5 * views[1].view.height)};
+  const Eigen::Vector3d isocentre = image::triangulate_linear(truth_views, centres);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const Eigen::Vector3d X = isocentre + Eigen::Vector3d(30, -20, 150);
+    EXPECT_LT(
+        (image::project(from_dicom.views[k], X - isocentre) - image::project(truth_views[k], X))
+            .norm(),
+        1e-6);
   }
   // Back-projecting the femoral head from both views recovers it (3D -> 2D -> 3D).
   const auto& head = truth["landmarks"]["femoral_head_centre_r"];
