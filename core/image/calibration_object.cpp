@@ -9,15 +9,14 @@
 namespace mmm::image {
 namespace {
 
-using Json = nlohmann::json;
-
 constexpr std::size_t kMaxBytes = std::size_t{1} << 20U;
 
-Json root_of(std::string_view text, const std::filesystem::path& source, const char* format) {
+nlohmann::json root_of(std::string_view text, const std::filesystem::path& source,
+                       const char* format) {
   if (text.size() > kMaxBytes) {
     throw IoError(source, "is " + std::to_string(text.size()) + " bytes; at most 1 MiB");
   }
-  Json root;
+  nlohmann::json root;
   try {
     root = parse_json(text);
   } catch (const std::exception& error) {
@@ -34,14 +33,14 @@ Json root_of(std::string_view text, const std::filesystem::path& source, const c
 
 // A JSON array of `size` finite numbers.
 template <int N>
-Eigen::Matrix<double, N, 1> numbers(const Json& value, const std::filesystem::path& source,
-                                    const std::string& where) {
+Eigen::Matrix<double, N, 1> numbers(const nlohmann::json& value,
+                                    const std::filesystem::path& source, const std::string& where) {
   if (!value.is_array() || value.size() != N) {
     throw IoError(source, where + ": must be an array of " + std::to_string(N) + " numbers");
   }
   Eigen::Matrix<double, N, 1> out;
   for (int k = 0; k < N; ++k) {
-    const Json& x = value[static_cast<std::size_t>(k)];
+    const nlohmann::json& x = value[static_cast<std::size_t>(k)];
     if (!x.is_number() || !std::isfinite(x.get<double>())) {
       throw IoError(source, where + "[" + std::to_string(k) + "]: must be a finite number");
     }
@@ -54,7 +53,7 @@ Eigen::Matrix<double, N, 1> numbers(const Json& value, const std::filesystem::pa
 
 CalibrationObject parse_calibration_object(std::string_view text,
                                            const std::filesystem::path& source) {
-  const Json root = root_of(text, source, "mmm-calibration-object");
+  const nlohmann::json root = root_of(text, source, "mmm-calibration-object");
   CalibrationObject object;
   object.name = root.value("name", "");
   if (!root.contains("beads") || !root["beads"].is_object() || root["beads"].empty()) {
@@ -68,7 +67,7 @@ CalibrationObject parse_calibration_object(std::string_view text,
 
 BeadClicks parse_bead_clicks(std::string_view text, const std::filesystem::path& source,
                              const CalibrationObject& object) {
-  const Json root = root_of(text, source, "mmm-bead-clicks");
+  const nlohmann::json root = root_of(text, source, "mmm-bead-clicks");
   if (!root.contains("views") || !root["views"].is_object() || root["views"].empty()) {
     throw IoError(source, "field 'views' must be an object of view name -> {bead: [u, v]}");
   }
