@@ -34,22 +34,6 @@ struct BeadResidualCost {
   }
 };
 
-// Centroid and RMS distance normalisation of 2-D or 3-D points.
-template <int D>
-Eigen::Matrix<double, D + 1, D + 1> normaliser(const std::vector<Eigen::Matrix<double, D, 1>>& x) {
-  Eigen::Matrix<double, D, 1> centre = Eigen::Matrix<double, D, 1>::Zero();
-  for (const auto& p : x) centre += p;
-  centre /= static_cast<double>(x.size());
-  double sum = 0;
-  for (const auto& p : x) sum += (p - centre).squaredNorm();
-  const double rms = std::sqrt(sum / static_cast<double>(x.size()));
-  const double scale = rms > 0 ? std::sqrt(static_cast<double>(D)) / rms : 1.0;
-  Eigen::Matrix<double, D + 1, D + 1> T = Eigen::Matrix<double, D + 1, D + 1>::Identity();
-  T.template topLeftCorner<D, D>() *= scale;
-  T.template topRightCorner<D, 1>() = -scale * centre;
-  return T;
-}
-
 // The linear start of a slot-scanning view (see the header).
 Eigen::Matrix<double, 3, 4> slot_start(std::span<const BeadPixel> beads) {
   std::vector<Eigen::Vector3d> points;
@@ -58,7 +42,7 @@ Eigen::Matrix<double, 3, 4> slot_start(std::span<const BeadPixel> beads) {
     points.push_back(bead.position_mm);
     pixels.push_back(bead.pixel);
   }
-  const Eigen::Matrix4d T = normaliser<3>(points);
+  const Eigen::Matrix4d T = normalising_transform<3>(std::span<const Eigen::Vector3d>(points));
   const auto n = static_cast<Eigen::Index>(beads.size());
   // Row 1: v = q . (T [X 1]) in least squares, then p2 = q T.
   Eigen::MatrixXd A(n, 4);

@@ -6,27 +6,6 @@
 #include "core/errors.h"
 
 namespace mmm::image {
-namespace {
-
-// The similarity taking `points` to their centroid at the origin and an RMS
-// distance of sqrt(dimension) (H & Z, section 4.4.4).
-template <int D>
-Eigen::Matrix<double, D + 1, D + 1> normalising_transform(
-    std::span<const Eigen::Matrix<double, D, 1>> points) {
-  Eigen::Matrix<double, D, 1> centre = Eigen::Matrix<double, D, 1>::Zero();
-  for (const auto& p : points) centre += p;
-  centre /= static_cast<double>(points.size());
-  double sum_squares = 0;
-  for (const auto& p : points) sum_squares += (p - centre).squaredNorm();
-  const double rms = std::sqrt(sum_squares / static_cast<double>(points.size()));
-  const double scale = rms > 0 ? std::sqrt(static_cast<double>(D)) / rms : 1.0;
-  Eigen::Matrix<double, D + 1, D + 1> T = Eigen::Matrix<double, D + 1, D + 1>::Identity();
-  T.template topLeftCorner<D, D>() *= scale;
-  T.template topRightCorner<D, 1>() = -scale * centre;
-  return T;
-}
-
-}  // namespace
 
 RadiographView fit_pinhole_view(std::span<const Eigen::Vector3d> points,
                                 std::span<const Eigen::Vector2d> pixels, const std::string& name,

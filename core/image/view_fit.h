@@ -10,12 +10,31 @@
 // fitted to an EOS-type scan is exact only at one height and one depth).
 
 #include <Eigen/Core>
+#include <cmath>
 #include <span>
 #include <string>
 
 #include "core/image/projection.h"
 
 namespace mmm::image {
+
+// The similarity taking `points` to their centroid at the origin and an RMS
+// distance of sqrt(dimension) (H & Z, section 4.4.4).
+template <int D>
+Eigen::Matrix<double, D + 1, D + 1> normalising_transform(
+    std::span<const Eigen::Matrix<double, D, 1>> points) {
+  Eigen::Matrix<double, D, 1> centre = Eigen::Matrix<double, D, 1>::Zero();
+  for (const auto& p : points) centre += p;
+  centre /= static_cast<double>(points.size());
+  double sum_squares = 0;
+  for (const auto& p : points) sum_squares += (p - centre).squaredNorm();
+  const double rms = std::sqrt(sum_squares / static_cast<double>(points.size()));
+  const double scale = rms > 0 ? std::sqrt(static_cast<double>(D)) / rms : 1.0;
+  Eigen::Matrix<double, D + 1, D + 1> T = Eigen::Matrix<double, D + 1, D + 1>::Identity();
+  T.template topLeftCorner<D, D>() *= scale;
+  T.template topRightCorner<D, 1>() = -scale * centre;
+  return T;
+}
 
 // The pinhole view whose projections of points[i] are nearest pixels[i] in
 // the algebraic sense of the DLT; width, height and the pixel spacing at the
