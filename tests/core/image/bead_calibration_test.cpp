@@ -45,11 +45,13 @@ std::array<RadiographView, 2> system_views(ProjectionModel model) {
 std::vector<BeadPixel> observe(const RadiographView& view, const std::vector<Eigen::Vector3d>& at,
                                double noise_px, unsigned seed) {
   std::mt19937 rng(seed);
-  std::normal_distribution<double> noise(0.0, noise_px);
+  // A normal distribution needs a spread > 0 (checked under _GLIBCXX_ASSERTIONS).
+  std::normal_distribution<double> noise(0.0, noise_px > 0 ? noise_px : 1.0);
+  const double gain = noise_px > 0 ? 1.0 : 0.0;
   std::vector<BeadPixel> beads;
   for (std::size_t i = 0; i < at.size(); ++i) {
-    beads.push_back({"b" + std::to_string(i), at[i],
-                     project(view, at[i]) + Eigen::Vector2d(noise(rng), noise(rng))});
+    const Eigen::Vector2d offset(noise(rng), noise(rng));
+    beads.push_back({"b" + std::to_string(i), at[i], project(view, at[i]) + gain * offset});
   }
   return beads;
 }
