@@ -39,7 +39,7 @@ struct SyntheticPatientOptions {
   bool soft_tissue_envelope = true;   // the limb filled (patient_radiographs.h)
   // Slot-scanning (EOS-type) views, or a conventional pinhole pair.
   image::ProjectionModel model = image::ProjectionModel::kSlotScanning;
-  bool write_dicom = false;  // also <view>.dcm (patient_radiographs.h)
+  bool write_dicom = false;             // also <view>.dcm (patient_radiographs.h)
   image::RadiographOptions radiograph;  // seed: the patient's seed unless set otherwise
   int threads = 2;
 };
