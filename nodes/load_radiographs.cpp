@@ -4,10 +4,13 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/errors.h"
 #include "core/image/deidentified_radiograph.h"
 #include "core/image/dicom_radiograph.h"
+#include "core/image/dicom_series.h"
 #include "core/image/dicom_views.h"
 #include "core/image/png.h"
 #include "core/image/radiograph_pair.h"
@@ -24,8 +27,18 @@ struct GivenImage {
   std::optional<image::DicomRadiograph> dicom;
 };
 
-GivenImage read_image(const std::string& bytes, const std::filesystem::path& source) {
+// `view` names the view the image is given for: a series (a folder of DICOM
+// files, de-identified by the study) gives the image of that view.
+GivenImage read_image(const std::string& bytes, const std::filesystem::path& source,
+                      const std::string& view, workflow::NodeContext& context) {
   if (image::looks_like_dicom(bytes)) return {{}, image::read_dicom_radiograph(bytes, source)};
+  if (image::is_deidentified_series(bytes)) {
+    std::vector<image::DicomRadiograph> series =
+        image::deidentified_series_from_text(bytes, source);
+    const image::SeriesChoice choice = image::choose_view_image(series, view, source);
+    context.info("view '" + view + "' from a DICOM folder: " + choice.reason);
+    return {{}, std::move(series[choice.index])};
+  }
   if (bytes.find(kDeidentifiedFormat) != std::string::npos && !bytes.empty() && bytes[0] == '{') {
     return {{}, image::deidentified_radiograph_from_text(bytes, source)};
   }
@@ -44,8 +57,12 @@ workflow::NodeSpec LoadRadiographs::spec() {
           "calibration",
           "View sidecar (views.json): projection matrices, sizes, spacing; without "
           "it the geometry comes from the DICOM attributes")
-      .input<File>("frontal", "Frontal radiograph: grayscale PNG or DICOM (DX, CR, SC)")
-      .input<File>("lateral", "Lateral radiograph: grayscale PNG or DICOM")
+      .input<File>("frontal",
+                   "Frontal radiograph: grayscale PNG or DICOM (DX, CR, SC), or a folder of "
+                   "DICOM files holding it (View Position AP or PA)")
+      .input<File>("lateral",
+                   "Lateral radiograph: grayscale PNG or DICOM, or a folder of DICOM files "
+                   "holding it (View Position LL or RL)")
       .param_enum("model", "pinhole", {"pinhole", "slot-scanning"},
                   "Projection model when the calibration comes from DICOM attributes: two "
                   "conventional radiographs, or an EOS-type slot scan")
@@ -55,7 +72,8 @@ workflow::NodeSpec LoadRadiographs::spec() {
 void LoadRadiographs::run(workflow::NodeContext& context) {
   std::map<std::string, GivenImage> given;
   for (const char* name : {"frontal", "lateral"}) {
-    given.emplace(name, read_image(context.input_bytes(name), context.input(name).path));
+    given.emplace(name,
+                  read_image(context.input_bytes(name), context.input(name).path, name, context));
   }
   std::vector<image::RadiographFile> views;
   std::filesystem::path source;

@@ -2,6 +2,7 @@
 
 #include "core/image/deidentified_radiograph.h"
 #include "core/image/dicom_radiograph.h"
+#include "core/image/dicom_series.h"
 #include "nodes/build_hulls.h"
 #include "nodes/build_muscle_lattice.h"
 #include "nodes/decimate_mesh.h"
@@ -49,6 +50,14 @@ workflow::NodeRegistry make_node_registry() {
                                 return image::deidentified_radiograph_text(
                                     image::read_dicom_radiograph(bytes, origin));
                               }});
+  // A folder of DICOM files (a series, or an exam with both views) is stored
+  // as its images de-identified, without the folder's file names.
+  registry.add_folder_importer(
+      {"DICOM series de-identification",
+       [](const std::filesystem::path& folder) { return image::folder_holds_dicom(folder); },
+       [](const std::filesystem::path& folder) {
+         return image::deidentified_series_text(image::read_dicom_folder(folder));
+       }});
   return registry;
 }
 

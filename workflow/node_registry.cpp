@@ -41,6 +41,29 @@ const FileImporter* NodeRegistry::importer_for(std::string_view head) const {
   return nullptr;
 }
 
+void NodeRegistry::add_folder_importer(FolderImporter importer) {
+  if (!importer.accepts || !importer.convert) {
+    throw InvalidInputError("folder importer '" + importer.name +
+                            "' needs both an accepts and a convert function");
+  }
+  folder_importers_.push_back(std::move(importer));
+}
+
+const FolderImporter* NodeRegistry::folder_importer_for(const std::filesystem::path& folder) const {
+  for (const FolderImporter& importer : folder_importers_) {
+    if (importer.accepts(folder)) return &importer;
+  }
+  return nullptr;
+}
+
+std::string NodeRegistry::folder_importer_names() const {
+  std::string names;
+  for (const FolderImporter& importer : folder_importers_) {
+    names += (names.empty() ? "" : ", ") + importer.name;
+  }
+  return names;
+}
+
 const NodeType* NodeRegistry::find(std::string_view name) const {
   const auto it = types_.find(name);
   return it == types_.end() ? nullptr : &it->second;

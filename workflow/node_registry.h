@@ -53,6 +53,17 @@ struct FileImporter {
 };
 inline constexpr std::size_t kImporterHeadBytes = 132;
 
+// The same for a folder given where a file is expected (a DICOM series as
+// exported from a PACS): the study stores what `convert` makes of it.
+struct FolderImporter {
+  std::string name;  // for messages, e.g. "DICOM series de-identification"
+  // Decides with a bounded look into the folder.
+  std::function<bool(const std::filesystem::path& folder)> accepts;
+  // The bytes to store for the folder; throws IoError naming the folder (or
+  // a file in it) when it cannot be converted.
+  std::function<std::string(const std::filesystem::path& folder)> convert;
+};
+
 class NodeRegistry {
  public:
   // Throws InvalidInputError when a type of that name is already registered,
@@ -81,9 +92,17 @@ class NodeRegistry {
   // The importer that accepts a file starting with `head`, or nullptr.
   [[nodiscard]] const FileImporter* importer_for(std::string_view head) const;
 
+  // Folder importers likewise, for a folder given for a File input.
+  void add_folder_importer(FolderImporter importer);
+  [[nodiscard]] const FolderImporter* folder_importer_for(
+      const std::filesystem::path& folder) const;
+  // The names of the folder importers, for hints ("" when there is none).
+  [[nodiscard]] std::string folder_importer_names() const;
+
  private:
   std::map<std::string, NodeType, std::less<>> types_;
   std::vector<FileImporter> importers_;
+  std::vector<FolderImporter> folder_importers_;
 };
 
 }  // namespace mmm::workflow

@@ -13,6 +13,8 @@
 #include "core/errors.h"
 #include "core/image/deidentified_radiograph.h"
 #include "core/image/dicom_radiograph.h"
+#include "core/image/dicom_series.h"
+#include "core/image/dicom_write.h"
 #include "core/image/projection.h"
 #include "core/image/radiograph_pair.h"
 #include "nodes/load_radiographs.h"
@@ -226,6 +228,96 @@ nodes:
   EXPECT_EQ(pair.image("frontal").pixels, original.image.pixels);
   EXPECT_EQ(pair.origins.at("frontal.png").sop_instance_uid_sha256,
             original.sop_instance_uid_sha256);
+}
+
+// A DX file of a reference view, written by mmm's writer, with an identity.
+std::string dicom_file_of(const image::RadiographView& view, bool frontal, int seed) {
+  const image::DicomRadiograph dicom = dicom_of(view, frontal ? "AP" : "LL", seed);
+  image::DicomExport options;
+  options.view_position = frontal ? "AP" : "LL";
+  options.patient_orientation =
+      frontal ? std::array<std::string, 2>{"L", "F"} : std::array<std::string, 2>{"A", "F"};
+  options.row_pitch_mm = kPitch;
+  options.column_pitch_mm = kPitch;
+  options.source_to_detector_mm = kSid;
+  options.source_to_patient_mm = kSod;
+  options.patient_name = "ROE^JANET^SERIES";
+  options.patient_id = "PID-SERIES-77";
+  options.patient_birth_date = "19610704";
+  options.study_date = "20251111";
+  options.sop_instance_uid = "2.25.77" + std::to_string(seed);
+  return image::dicom_radiograph_bytes(dicom.image, options);
+}
+
+// An exam exported as one folder per series (named after the patient, as
+// exports often are), given for both views: each view finds its own image,
+// the pair is the one the two files give, and nothing of the identity or of
+// the folder names is stored.
+TEST(LoadDicomRadiographsTest, AnExamFolderGivesBothViewsAndIsStoredDeidentified) {
+  const mmm::test::ScratchDir root("dicom-exam");
+  const auto reference = reference_views(image::ProjectionModel::kSlotScanning);
+  const std::filesystem::path exam = root.path() / "ROE_JANET_EXAM";
+  const std::string frontal_bytes = dicom_file_of(reference[0], true, 1);
+  const std::string lateral_bytes = dicom_file_of(reference[1], false, 2);
+  mmm::test::write_file(exam / "SERIES_LAT" / "IM0001.dcm", lateral_bytes);
+  mmm::test::write_file(exam / "SERIES_AP" / "IM0001.dcm", frontal_bytes);
+  mmm::test::write_file(exam / "DICOMDIR", "index");
+  const std::filesystem::path workflow_file =
+      mmm::test::write_file(root.path() / "wf.yaml", R"yaml(mmm_workflow: 1
+name: dicom_exam
+inputs:
+  frontal: {type: File}
+  lateral: {type: File}
+nodes:
+  - {id: radiographs, type: load_radiographs, params: {model: slot-scanning}, inputs: {frontal: study.frontal, lateral: study.lateral}}
+)yaml");
+  const workflow::NodeRegistry registry = make_node_registry();
+  const std::filesystem::path dir = root.path() / "study";
+  workflow::Study study = workflow::Study::create(
+      dir, {workflow_file, {{"frontal", exam.string()}, {"lateral", exam.string()}}, {"t", "t"}},
+      registry);
+  const std::string stored = folder_bytes(dir);
+  for (const char* identifying : {"ROE^JANET", "ROE_JANET", "PID-SERIES-77", "19610704", "20251111",
+                                  "SERIES_AP", "IM0001", "2.25.771"}) {
+    const std::size_t at = stored.find(identifying);
+    EXPECT_EQ(at, std::string::npos)
+        << identifying << " in: " << stored.substr(at < 80 ? 0 : at - 80, 160);
+  }
+  const std::string series = study.artifacts().get(study.inputs().at("frontal").hash);
+  EXPECT_TRUE(image::is_deidentified_series(series));
+
+  test::NodeHarness from_folder;
+  const auto folder_out =
+      from_folder.run<LoadRadiographs>({{"frontal", from_folder.add(PortType::kFile, series)},
+                                        {"lateral", from_folder.add(PortType::kFile, series)}},
+                                       {{"model", "slot-scanning"}});
+  test::NodeHarness from_files;
+  const auto files_out =
+      from_files.run<LoadRadiographs>({{"frontal", from_files.add(PortType::kFile, frontal_bytes)},
+                                       {"lateral", from_files.add(PortType::kFile, lateral_bytes)}},
+                                      {{"model", "slot-scanning"}});
+  EXPECT_EQ(mmm::test::read_text(folder_out.at("radiographs").path),
+            mmm::test::read_text(files_out.at("radiographs").path));
+  const image::RadiographPair pair = image::radiograph_pair_from_json_text(
+      mmm::test::read_text(folder_out.at("radiographs").path), "output");
+  const Eigen::Vector3d X(30, -20, 150);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_LT((image::project(pair.views[k].view, X) - image::project(reference[k], X)).norm(),
+              1e-6);
+  }
+}
+
+TEST(LoadDicomRadiographsTest, AFolderWithoutTheViewNamesWhatItHolds) {
+  const auto reference = reference_views(image::ProjectionModel::kPinhole);
+  const std::string series = image::deidentified_series_text(
+      {dicom_of(reference[0], "AP", 1), dicom_of(reference[0], "PA", 3)});
+  test::NodeHarness harness;
+  EXPECT_THAT(
+      [&] {
+        (void)harness.run<LoadRadiographs>({{"frontal", harness.add(PortType::kFile, series)},
+                                            {"lateral", harness.add(PortType::kFile, series)}});
+      },
+      ::testing::ThrowsMessage<IoError>(HasSubstr("with a View Position (0018,5101) of AP or PA")));
 }
 
 }  // namespace

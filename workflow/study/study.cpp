@@ -44,6 +44,9 @@ struct FileStamp {
   std::int64_t size = 0;
   std::int64_t mtime_ns = 0;
   bool is_directory = false;
+  // For a folder given for a File input: the importer that takes it (e.g. a
+  // DICOM series), or nullptr when the folder cannot be used.
+  const FolderImporter* folder_importer = nullptr;
 };
 
 std::int64_t mtime_ns_of(const struct stat& info) {
@@ -72,13 +75,20 @@ FileStamp directory_stamp(const std::filesystem::path& dir, const struct stat& d
 
 // The stamp of a regular file or a folder given for an input of type
 // `type`; std::nullopt when `origin` is neither (or does not exist). A folder
-// given where none is accepted is not walked (a mistyped "/" costs nothing):
-// its stamp only says that it is a folder.
-std::optional<FileStamp> stamp_of(const std::filesystem::path& origin, PortType type) {
+// given where none is accepted, and that no folder importer takes (their
+// look is bounded), is not walked (a mistyped "/" costs little): its stamp
+// only says that it is a folder.
+std::optional<FileStamp> stamp_of(const std::filesystem::path& origin, PortType type,
+                                  const NodeRegistry& registry) {
   struct stat info {};
   if (::stat(origin.c_str(), &info) != 0) return std::nullopt;
   if (S_ISDIR(info.st_mode)) {
-    return accepts_folder(type) ? directory_stamp(origin, info) : FileStamp{0, 0, true};
+    if (accepts_folder(type)) return directory_stamp(origin, info);
+    const FolderImporter* importer = registry.folder_importer_for(origin);
+    if (importer == nullptr) return FileStamp{0, 0, true};
+    FileStamp stamp = directory_stamp(origin, info);
+    stamp.folder_importer = importer;
+    return stamp;
   }
   if (!S_ISREG(info.st_mode)) return std::nullopt;
   return FileStamp{static_cast<std::int64_t>(info.st_size), mtime_ns_of(info), false};
@@ -90,26 +100,53 @@ std::string input_value_hint(PortType type) {
   return accepts_folder(type) ? "DIR" : "PATH";
 }
 
-// Stores the content of an input's origin: a file's bytes, or a folder's
-// bundle. Returns the artifact hash.
-std::string store_origin(ArtifactStore& artifacts, const std::filesystem::path& origin,
-                         const FileStamp& stamp, const NodeRegistry& registry) {
+// What store_origin() stored: the artifact, and the name of the importer
+// that converted the origin ("" when it was stored as given).
+struct StoredOrigin {
+  std::string hash;
+  std::string importer;
+};
+
+// Stores the content of an input's origin: a file's bytes, a folder's
+// bundle, or what an importer makes of either.
+StoredOrigin store_origin(ArtifactStore& artifacts, const std::filesystem::path& origin,
+                          const FileStamp& stamp, const NodeRegistry& registry) {
   if (stamp.size > kMaxStudyInputBytes) {
     throw IoError(origin, std::string(stamp.is_directory ? "holds " : "is ") +
                               std::to_string(stamp.size) + " bytes; a study input is at most " +
                               std::to_string(kMaxStudyInputBytes) +
                               " (1 GiB); hint: check that this is the file you meant");
   }
-  if (stamp.is_directory) return artifacts.put(pack_directory(origin));
+  if (stamp.is_directory) {
+    if (stamp.folder_importer != nullptr) {
+      return {artifacts.put(stamp.folder_importer->convert(origin)), stamp.folder_importer->name};
+    }
+    return {artifacts.put(pack_directory(origin)), ""};
+  }
   // A file of a kind that must not be stored as given (e.g. DICOM, with the
   // patient's identity in it) is stored as its importer converts it.
   const auto size = static_cast<std::uintmax_t>(stamp.size);
   const std::string head =
       read_file_bytes(origin, std::min<std::uintmax_t>(size, kImporterHeadBytes));
   if (const FileImporter* importer = registry.importer_for(head)) {
-    return artifacts.put(importer->convert(read_file_bytes(origin, size), origin));
+    return {artifacts.put(importer->convert(read_file_bytes(origin, size), origin)),
+            importer->name};
   }
-  return artifacts.put_file(origin);
+  return {artifacts.put_file(origin), ""};
+}
+
+// What a study records as `given` for an input that an importer converted.
+// Importers exist to keep out what identifies a patient, and a path often
+// does (an export's folders are named after the patient): the path is not
+// kept, so such an input is not followed by refresh_file_inputs(); giving
+// it again (set_input) replaces it.
+std::string imported_origin_label(const std::string& importer) {
+  return "(" + importer + "; the path is not kept)";
+}
+
+// True when `record` remembers where its content came from on disk.
+bool origin_is_kept(const StudyInputRecord& record) {
+  return record.is_file && std::filesystem::path(record.given).is_absolute();
 }
 
 std::string diagnostics_text(const LoadResult& result) {
@@ -357,7 +394,7 @@ StudyInputRecord Study::import_input(const StudyInput& declared, std::string_vie
     return record;
   }
   const std::filesystem::path origin = std::filesystem::absolute(text).lexically_normal();
-  const std::optional<FileStamp> stamp = stamp_of(origin, record.type);
+  const std::optional<FileStamp> stamp = stamp_of(origin, record.type, *registry_);
   const std::string hint = "; hint: give the path of the " +
                            std::string(accepts_folder(record.type) ? "atlas folder (or of a "
                                                                      "packed bundle file)"
@@ -370,17 +407,26 @@ StudyInputRecord Study::import_input(const StudyInput& declared, std::string_vie
                                                    : ": no such file (or not a regular file)") +
                       hint);
   }
-  if (stamp->is_directory && !accepts_folder(record.type)) {
-    throw IoError(origin,
-                  what + ": is a folder, but only Atlas inputs may be given as a folder" + hint);
+  if (stamp->is_directory && !accepts_folder(record.type) && stamp->folder_importer == nullptr) {
+    const std::string importers = registry_->folder_importer_names();
+    throw IoError(origin, what + ": is a folder, but only Atlas inputs" +
+                              (importers.empty()
+                                   ? std::string()
+                                   : ", and folders that an importer takes (" + importers + "),") +
+                              " may be given as a folder" + hint);
   }
   // A folder input is still "a file's content" for the record: its origin is
   // re-checked by refresh_file_inputs() like a file's.
   record.is_file = true;
-  record.given = origin.string();
-  record.source_size = stamp->size;
-  record.source_mtime_ns = stamp->mtime_ns;
-  record.hash = store_origin(artifacts_, origin, *stamp, *registry_);
+  const StoredOrigin stored = store_origin(artifacts_, origin, *stamp, *registry_);
+  record.hash = stored.hash;
+  if (stored.importer.empty()) {
+    record.given = origin.string();
+    record.source_size = stamp->size;
+    record.source_mtime_ns = stamp->mtime_ns;
+  } else {
+    record.given = imported_origin_label(stored.importer);
+  }
   return record;
 }
 
@@ -420,19 +466,30 @@ bool Study::set_input(std::string_view name, std::string_view text) {
 std::vector<std::string> Study::refresh_file_inputs() {
   std::vector<std::string> changes;
   for (const auto& [name, record] : inputs()) {
-    if (!record.is_file) continue;
-    const std::optional<FileStamp> stamp = stamp_of(record.given, record.type);
+    if (!origin_is_kept(record)) continue;
+    const std::optional<FileStamp> stamp = stamp_of(record.given, record.type, *registry_);
     // An origin that is gone, or became a folder where only a file will do,
     // is not a change: keep using the stored copy.
-    if (!stamp || (stamp->is_directory && !accepts_folder(record.type))) continue;
+    if (!stamp || (stamp->is_directory && !accepts_folder(record.type) &&
+                   stamp->folder_importer == nullptr)) {
+      continue;
+    }
     if (stamp->size == record.source_size && stamp->mtime_ns == record.source_mtime_ns) continue;
     StudyInputRecord updated = record;
     updated.source_size = stamp->size;
     updated.source_mtime_ns = stamp->mtime_ns;
-    updated.hash = store_origin(artifacts_, record.given, *stamp, *registry_);
+    const StoredOrigin stored = store_origin(artifacts_, record.given, *stamp, *registry_);
+    updated.hash = stored.hash;
+    // The origin became a file an importer converts (a DICOM file written
+    // over a PNG): from now on its path is not kept either.
+    if (!stored.importer.empty()) {
+      updated.given = imported_origin_label(stored.importer);
+      updated.source_size = 0;
+      updated.source_mtime_ns = 0;
+    }
     if (updated.hash != record.hash) {
       updated.updated_at = utc_now();
-      changes.push_back("study input '" + name + "' changed: " + record.given +
+      changes.push_back("study input '" + name + "' changed: " + updated.given +
                         " has new content (SHA-256 " + record.hash.substr(0, 12) + "... -> " +
                         updated.hash.substr(0, 12) + "...)");
     }

@@ -45,8 +45,11 @@ struct StudyInputRecord {
   std::string name;
   PortType type = PortType::kFile;
   std::string hash;
-  bool is_file = false;              // a file's content (else a value typed by the user)
-  std::string given;                 // the value text, or the file's absolute path when imported
+  bool is_file = false;  // a file's content (else a value typed by the user)
+  // The value text, or the absolute path of the file or folder given; for
+  // content an importer converted (a DICOM file), a label instead: the path
+  // is not kept (it may name the patient), nor followed on refresh.
+  std::string given;
   std::int64_t source_size = 0;      // files: size and modification time at import,
   std::int64_t source_mtime_ns = 0;  // to notice a changed file cheaply
   std::string updated_at;
