@@ -26,6 +26,8 @@ constexpr std::pair<std::string_view, mmm::fuzz::Target> kTargets[] = {
     {"submission", mmm::fuzz::submission},
     {"views", mmm::fuzz::views},
     {"png", mmm::fuzz::png},
+    {"dicom", mmm::fuzz::dicom},
+    {"deidentified", mmm::fuzz::deidentified},
 };
 
 mmm::fuzz::Target g_target = nullptr;

@@ -26,5 +26,7 @@ void markups(const std::uint8_t* data, std::size_t size);
 void submission(const std::uint8_t* data, std::size_t size);
 void views(const std::uint8_t* data, std::size_t size);
 void png(const std::uint8_t* data, std::size_t size);
+void dicom(const std::uint8_t* data, std::size_t size);
+void deidentified(const std::uint8_t* data, std::size_t size);
 
 }  // namespace mmm::fuzz
