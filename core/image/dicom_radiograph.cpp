@@ -34,6 +34,7 @@
 #include "core/hash/sha256.h"
 #include "core/image/dicom_structure.h"
 #include "core/image/file_bytes.h"
+#include "core/process/isolated_run.h"
 
 namespace mmm::image {
 
@@ -472,6 +473,14 @@ bool looks_like_dicom(std::string_view bytes) {
   return group == 0x0002 || group == 0x0008;
 }
 
+namespace {
+
+// What read_dicom_radiograph() does once the file was decoded safely in a
+// child process: the same decoding, in this one.
+DicomRadiograph decode_dicom_radiograph(std::string_view bytes, const fs::path& source);
+
+}  // namespace
+
 DicomRadiograph read_dicom_radiograph(std::string_view bytes, const fs::path& source) {
   if (bytes.size() > kDicomMaxFileBytes) {
     throw IoError(source, "is " + std::to_string(bytes.size() >> 20U) + " MiB, above the " +
@@ -485,8 +494,26 @@ DicomRadiograph read_dicom_radiograph(std::string_view bytes, const fs::path& so
                   "(expected a DICOM Part 10 file as exported by the PACS, not a picture or a "
                   "report)");
   }
-  // Truncated and malformed files make GDCM abort (dicom_structure.h).
+  // Truncated and malformed files make GDCM abort (dicom_structure.h): the
+  // walk refuses them with a message naming the element.
   detail::check_dicom_structure(bytes, source);
+  // What the walk does not catch (an attribute of the wrong VR, a broken
+  // compressed stream) GDCM or its codecs may still abort on: decode first in
+  // a child process (isolated_run.h), here only once that came through.
+  const process::IsolatedOutcome trial = process::run_isolated(
+      [&] { (void)decode_dicom_radiograph(bytes, source); }, kDicomDecodeTimeLimit);
+  if (!trial.came_through) {
+    throw IoError(source, "could not be decoded: the DICOM library " + trial.description() +
+                              " reading it; the file is malformed (or, if it took too long, "
+                              "too large); hint: export the image again from the modality or "
+                              "the PACS");
+  }
+  return decode_dicom_radiograph(bytes, source);
+}
+
+namespace {
+
+DicomRadiograph decode_dicom_radiograph(std::string_view bytes, const fs::path& source) {
   silence_gdcm();
   ByteViewBuffer buffer(bytes);
   std::istream stream(&buffer);
@@ -632,6 +659,8 @@ DicomRadiograph read_dicom_radiograph(std::string_view bytes, const fs::path& so
   }
   return out;
 }
+
+}  // namespace
 
 DicomRadiograph read_dicom_radiograph(const fs::path& path) {
   const std::string bytes = detail::read_file_bytes(path, "a DICOM file", kDicomMaxFileBytes);

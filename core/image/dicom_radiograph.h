@@ -22,6 +22,7 @@
 // not the stored values, is what the window refers to.
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -38,6 +39,9 @@ inline constexpr std::uintmax_t kDicomMaxFileBytes = std::uintmax_t{512} << 20U;
 // Rows and Columns above this are refused before any pixel is decoded (an
 // EOS full-body image is about 2,000 x 9,000).
 inline constexpr int kDicomMaxSide = 20'000;
+// The longest a trial decoding (in a child process, see read_dicom_radiograph)
+// may take: a 512 MiB JPEG 2000 image decodes in well under a minute.
+inline constexpr std::chrono::seconds kDicomDecodeTimeLimit{120};
 
 // Where the display window comes from.
 enum class DicomWindowSource {
@@ -122,13 +126,14 @@ struct DicomRadiograph {
 bool looks_like_dicom(std::string_view bytes);
 
 // Reads a radiograph from a DICOM file's bytes; `source` names the file in
-// messages. Throws IoError naming `source` and the attribute at fault, with a
-// hint: above kDicomMaxFileBytes; not DICOM; truncated; an unknown transfer
-// syntax or one GDCM cannot decode (the UID named); no Pixel Data
-// (7FE0,0010); a SOP class other than CR, DX or secondary capture; Samples
-// per Pixel != 1 or a colour Photometric Interpretation; Bits Allocated other
-// than 8 / 16 or Bits Stored outside 8..16; Rows or Columns zero or above
-// kDicomMaxSide; more than one frame; a non-numeric or non-finite DS value; a
+// messages. The bytes are decoded first in a child process
+// (core/process/isolated_run.h): a file that makes GDCM or a codec abort or
+// crash is refused here, the calling process unharmed. Throws IoError naming `source` and the
+// attribute at fault, with a hint: above kDicomMaxFileBytes; not DICOM; truncated; an unknown
+// transfer syntax or one GDCM cannot decode (the UID named); no Pixel Data (7FE0,0010); a SOP class
+// other than CR, DX or secondary capture; Samples per Pixel != 1 or a colour Photometric
+// Interpretation; Bits Allocated other than 8 / 16 or Bits Stored outside 8..16; Rows or Columns
+// zero or above kDicomMaxSide; more than one frame; a non-numeric or non-finite DS value; a
 // spacing, distance or magnification that is not > 0; a Rescale Slope of 0; a
 // Window Width < 1; a Patient Orientation or Image Laterality that is not
 // one of the defined codes; a Modality LUT Sequence.

@@ -451,3 +451,29 @@ TEST(DicomRadiographTest, SpacingIsParsedStrictly) {
 
 }  // namespace
 }  // namespace mmm::image
+
+namespace mmm::image {
+namespace {
+
+// Found by the fuzzer: Columns (0028,0011) with VR SS instead of US makes
+// Debian's GDCM fail an assertion, which used to abort the whole process.
+// The trial decoding in a child process turns that into an error.
+TEST(DicomRadiographTest, AFileThatMakesGdcmAbortIsRefusedAndThisProcessLives) {
+  const std::filesystem::path file =
+      test::source_dir() / "fuzz" / "regressions" / "dicom" / "columns_with_vr_ss.dcm";
+  try {
+    (void)read_dicom_radiograph(file);
+    FAIL() << "no error";
+  } catch (const IoError& error) {
+    EXPECT_EQ(error.path(), file);
+    EXPECT_THAT(error.what(), ::testing::HasSubstr("could not be decoded: the DICOM library "
+                                                   "crashed (SIGABRT"));
+    EXPECT_THAT(error.what(), ::testing::HasSubstr("hint: export the image again"));
+  }
+  // And a good file still reads, in this process, after that.
+  EXPECT_EQ(read_dicom_radiograph(test::dicom::fixture("dx_mono2_16bit.dcm")).columns,
+            test::dicom::kWidth);
+}
+
+}  // namespace
+}  // namespace mmm::image
