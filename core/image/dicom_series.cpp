@@ -96,9 +96,8 @@ void walk_folder(const fs::path& folder, bool strict,
       if (!visit(child.path(), size)) return;
     }
     // Depth first, in path order: push in reverse so the first comes out first.
-    for (auto it = subfolders.rbegin(); it != subfolders.rend(); ++it) {
-      pending.emplace_back(*it, depth + 1);
-    }
+    std::reverse(subfolders.begin(), subfolders.end());
+    for (const fs::path& subfolder : subfolders) pending.emplace_back(subfolder, depth + 1);
   }
 }
 

@@ -29,10 +29,9 @@ using ::testing::SizeIs;
 FolderImporter parts_importer() {
   return {"parts joining",
           [](const fs::path& folder) {
-            for (const auto& entry : fs::directory_iterator(folder)) {
-              if (entry.path().extension() == ".part") return true;
-            }
-            return false;
+            return std::ranges::any_of(fs::directory_iterator(folder), [](const auto& entry) {
+              return entry.path().extension() == ".part";
+            });
           },
           [](const fs::path& folder) {
             std::vector<std::string> parts;
