@@ -5,8 +5,11 @@
 // files) sets the exit code instead of throwing.
 
 #include <CLI/CLI.hpp>
+#include <string>
+#include <utility>
 
 #include "workflow/node_registry.h"
+#include "workflow/study/study.h"
 
 namespace mmm::app {
 
@@ -40,6 +43,17 @@ void register_report_commands(CLI::App& app, const workflow::NodeRegistry& regis
 
 // mmm serve: the operator web UI (the registry must outlive the server)
 void register_serve_commands(CLI::App& app, const workflow::NodeRegistry& registry);
+
+// mmm cohort create|run|status, mmm gc (the registry must outlive the parse)
+void register_cohort_commands(CLI::App& app, const workflow::NodeRegistry& registry);
+
+// This program's version and build revision, recorded with what it creates.
+workflow::Provenance this_program();
+
+// "NAME=VALUE" -> {NAME, VALUE}; throws InvalidInputError naming `what`
+// otherwise.
+std::pair<std::string, std::string> split_assignment(const std::string& text,
+                                                     const std::string& what);
 
 // Exit codes of every command (documented in docs/architecture.md, "Exit codes").
 inline constexpr int kExitOk = 0;       // done

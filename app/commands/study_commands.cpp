@@ -12,7 +12,6 @@
 #include "app/commands/commands.h"
 #include "app/commands/study_report.h"
 #include "core/errors.h"
-#include "mmm_git_revision.h"
 #include "workflow/run/progress_display.h"
 #include "workflow/run/run_study.h"
 #include "workflow/study/study.h"
@@ -20,18 +19,6 @@
 
 namespace mmm::app {
 namespace {
-
-workflow::Provenance this_program() { return {MMM_VERSION, MMM_GIT_REVISION}; }
-
-// "NAME=VALUE" -> {NAME, VALUE}; throws InvalidInputError otherwise.
-std::pair<std::string, std::string> split_assignment(const std::string& text,
-                                                     const std::string& what) {
-  const std::size_t equals = text.find('=');
-  if (equals == std::string::npos || equals == 0) {
-    throw InvalidInputError(what + " '" + text + "' is not of the form NAME=VALUE");
-  }
-  return {text.substr(0, equals), text.substr(equals + 1)};
-}
 
 struct CreateArgs {
   std::string dir;

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <string>
 #include <system_error>
@@ -170,6 +171,25 @@ class TempBlob {
   bool committed_ = false;
 };
 
+enum class LinkResult { kLinked, kExists, kFailed };
+
+// Gives the file `from` the new name `to` (link(2)), creating `to`'s shard
+// folder. kExists when `to` already names a file; kFailed for any other
+// refusal (`from` gone, another file system, too many links).
+LinkResult link_name(const std::filesystem::path& from, const std::filesystem::path& to) {
+  const std::filesystem::path shard = to.parent_path();
+  if (::mkdir(shard.c_str(), 0755) != 0 && errno != EEXIST) return LinkResult::kFailed;
+  if (::link(from.c_str(), to.c_str()) == 0) return LinkResult::kLinked;
+  return errno == EEXIST ? LinkResult::kExists : LinkResult::kFailed;
+}
+
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  struct stat first {};
+  struct stat second {};
+  return ::stat(a.c_str(), &first) == 0 && ::stat(b.c_str(), &second) == 0 &&
+         first.st_dev == second.st_dev && first.st_ino == second.st_ino;
+}
+
 std::string read_whole_file(const std::filesystem::path& path, const std::string& hash) {
   const Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
   if (!fd.valid()) {
@@ -226,6 +246,7 @@ std::string ArtifactStore::put(std::string_view bytes) {
   std::string hash = hash::sha256_hex(bytes);
   const std::filesystem::path final_path = path_of(hash);
   if (is_regular_file_of_size(final_path, bytes.size()) && trust_existing(hash)) return hash;
+  if (adopt_from_pool(hash, bytes.size())) return hash;
   TempBlob temp(root_);
   // Fault points: a crash half-way through the bytes must leave only a
   // temporary file behind.
@@ -235,6 +256,7 @@ std::string ArtifactStore::put(std::string_view bytes) {
   fault_point("artifact.mid_write");
   temp.write(bytes.substr(half));
   temp.commit(root_, final_path, durability_ == Durability::kSyncEachWrite);
+  publish_to_pool(hash, bytes.size());
   return hash;
 }
 
@@ -263,8 +285,65 @@ std::string ArtifactStore::put_file(const std::filesystem::path& source) {
   // Already stored: the destructor of `temp` deletes the copy.
   if (!is_regular_file_of_size(final_path, size) || !trust_existing(hash)) {
     temp.commit(root_, final_path, durability_ == Durability::kSyncEachWrite);
+    publish_to_pool(hash, size);
   }
   return hash;
+}
+
+bool ArtifactStore::adopt_from_pool(const std::string& hash, std::size_t size) const {
+  if (!pool_) return false;
+  const std::filesystem::path shared = *pool_ / relative_path_of(hash);
+  if (!is_regular_file_of_size(shared, size)) return false;
+  // Deferred writers trust nothing unsynced: the pool's blob too is checked.
+  if (durability_ == Durability::kDeferred) {
+    try {
+      if (hash::sha256_file_hex(shared) != hash) return false;
+    } catch (const IoError&) {
+      return false;
+    }
+  }
+  const std::filesystem::path final_path = path_of(hash);
+  switch (link_name(shared, final_path)) {
+    case LinkResult::kLinked:
+      if (durability_ == Durability::kSyncEachWrite) fsync_directory(final_path.parent_path());
+      return true;
+    case LinkResult::kExists:  // another writer of this study put it meanwhile
+      return is_regular_file_of_size(final_path, size);
+    case LinkResult::kFailed:  // e.g. collected from the pool meanwhile: write it
+      return false;
+  }
+  return false;
+}
+
+void ArtifactStore::publish_to_pool(const std::string& hash, std::size_t size) const {
+  if (!pool_) return;
+  const std::filesystem::path local = path_of(hash);
+  const std::filesystem::path shared = *pool_ / relative_path_of(hash);
+  const bool sync = durability_ == Durability::kSyncEachWrite;
+  switch (link_name(local, shared)) {
+    case LinkResult::kLinked:
+      if (sync) fsync_directory(shared.parent_path());
+      return;
+    case LinkResult::kFailed:  // another file system, a link limit: keep the own copy
+      return;
+    case LinkResult::kExists:
+      break;
+  }
+  // The pool had the blob (another study put it first): let this study's
+  // name point at the pool's file and free the copy. A temporary name first,
+  // then rename(2) over the study's name: atomic, the name always complete.
+  if (same_file(local, shared) || !is_regular_file_of_size(shared, size)) return;
+  static std::atomic<unsigned> next_link{0};
+  const std::filesystem::path temporary =
+      root_ / (std::string(kTempPrefix) + "link-" + hash.substr(0, 16) + "-" +
+               std::to_string(::getpid()) + "-" + std::to_string(next_link++));
+  ::unlink(temporary.c_str());
+  if (::link(shared.c_str(), temporary.c_str()) != 0) return;
+  if (::rename(temporary.c_str(), local.c_str()) != 0) {
+    ::unlink(temporary.c_str());
+    return;
+  }
+  if (sync) fsync_directory(local.parent_path());
 }
 
 std::string ArtifactStore::get(const std::string& hash) const {

@@ -30,6 +30,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -51,6 +52,20 @@ enum class Durability {
   kDeferred,
 };
 
+// Sharing (a cohort's studies under one root, shared_store.h): a store may
+// share its blobs with a pool, another store folder of the same layout. A
+// blob the pool has is not written again: the study's name for it becomes a
+// hard link to the pool's file (link(2) is atomic: the name appears complete
+// or not at all). A blob written by the study is linked into the pool for
+// the next study; if another study put the same blob there first, the
+// study's copy is replaced by a link to the pool's (rename over it). So
+// identical artifacts across the studies of a root take their size once,
+// while every study folder still holds all its blobs as ordinary files: it
+// can be copied, moved, read and verified alone. Whatever fails in sharing
+// (the pool on another file system, a link limit, a blob the pool's garbage
+// collection just removed) falls back to the study's own copy: sharing never
+// loses or fails a write.
+//
 // Every member taking a hash throws InvalidInputError when it is not 64
 // lowercase hex digits. One object may be shared by threads (it holds only the
 // root path).
@@ -61,6 +76,11 @@ class ArtifactStore {
   explicit ArtifactStore(std::filesystem::path root);
 
   [[nodiscard]] const std::filesystem::path& root() const { return root_; }
+
+  // Shares blobs with the store folder `pool` (see above). Set it before
+  // sharing the store between threads.
+  void share_with(std::filesystem::path pool) { pool_ = std::move(pool); }
+  [[nodiscard]] const std::optional<std::filesystem::path>& pool() const { return pool_; }
 
   // Stores `bytes` and returns their SHA-256 (64 lowercase hex digits). A blob
   // already present with the right size is not rewritten (same hash, same
@@ -111,8 +131,15 @@ class ArtifactStore {
 
  private:
   [[nodiscard]] bool trust_existing(const std::string& hash) const;
+  // Links the pool's blob into this store; false when the pool has none of
+  // that size (or it cannot be linked).
+  bool adopt_from_pool(const std::string& hash, std::size_t size) const;
+  // Links this store's new blob into the pool, or, when the pool has it
+  // already, makes this store's name a link to the pool's file.
+  void publish_to_pool(const std::string& hash, std::size_t size) const;
 
   std::filesystem::path root_;
+  std::optional<std::filesystem::path> pool_;
   Durability durability_ = Durability::kSyncEachWrite;
 };
 

@@ -20,6 +20,7 @@
 #include "core/suggest.h"
 #include "workflow/definition/workflow_loader.h"
 #include "workflow/host_and_time.h"
+#include "workflow/store/shared_store.h"
 #include "workflow/study/cache_key.h"
 #include "workflow/study/study_database.h"
 #include "workflow/study/value_text.h"
@@ -255,6 +256,10 @@ Study::Study(std::filesystem::path dir, WorkflowDefinition workflow, const NodeR
       database_(dir_ / kDatabaseFile),
       artifacts_(dir_ / "artifacts") {
   prepare_study_database(database_);
+  // Under a cohort's root, blobs are shared with the other studies.
+  if (const std::optional<std::filesystem::path> pool = find_shared_store(dir_)) {
+    artifacts_.share_with(*pool);
+  }
 }
 
 Study Study::create(const std::filesystem::path& dir, const CreateStudyOptions& options,
