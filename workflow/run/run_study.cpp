@@ -359,7 +359,8 @@ class Scheduler {
         .bind_text(4, options_.provenance.mmm_version)
         .bind_text(5, options_.provenance.git_revision)
         .bind_text(6, workflow_hash(study_.workflow()))
-        .bind_int64(7, std::max(1, options_.jobs));
+        .bind_int64(7, std::max(1, options_.jobs))
+        .step();
     summary_.run_id = database.last_insert_rowid();
     transaction.commit();
     std::error_code ignored;
@@ -556,7 +557,8 @@ class Scheduler {
         .bind_int64(4, static_cast<std::int64_t>(summary_.cached.size()))
         .bind_int64(5, static_cast<std::int64_t>(summary_.failed.size()))
         .bind_int64(6, static_cast<std::int64_t>(summary_.waiting.size()))
-        .bind_int64(7, summary_.run_id);
+        .bind_int64(7, summary_.run_id)
+        .step();
     transaction.commit();
     fault_point("run.finished");
   }
