@@ -16,7 +16,7 @@ APT_PACKAGES := build-essential cmake ninja-build pkg-config python3 \
   libeigen3-dev libopenmesh-dev libceres-dev libyaml-cpp-dev libspdlog-dev libfmt-dev \
   libtinyxml2-dev nlohmann-json3-dev libcli11-dev libsqlite3-dev zlib1g-dev \
   libgtest-dev libgmock-dev googletest libbenchmark-dev libcpp-httplib-dev \
-  libsuitesparse-dev libssl-dev libspng-dev libgdcm-dev python3-pydicom python3-numpy python3-pil ccache
+  libsuitesparse-dev libssl-dev libspng-dev libgdcm-dev python3-pydicom python3-numpy python3-pil slurm-wlm munge ccache
 # The browser test of the operator web UI (tests/web): headless Chromium and
 # npm for playwright-core (nodejs itself may come from Debian or NodeSource).
 WEB_TEST_PACKAGES := chromium

@@ -30,6 +30,7 @@ int run(int argc, char** argv) {
   mmm::app::register_workflow_commands(app, registry);
   mmm::app::register_study_commands(app, registry);
   mmm::app::register_cohort_commands(app, registry);
+  mmm::app::register_worker_commands(app, registry);
   mmm::app::register_task_commands(app, registry);
   mmm::app::register_report_commands(app, registry);
   mmm::app::register_serve_commands(app, registry);

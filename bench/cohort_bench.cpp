@@ -42,7 +42,8 @@ const mmm::workflow::NodeRegistry& registry() {
 const fs::path& cohort_root() {
   static const fs::path kRoot = [] {
     std::random_device random;
-    const fs::path base = fs::temp_directory_path() / ("mmm-bench-cohort-" + std::to_string(random()));
+    const fs::path base =
+        fs::temp_directory_path() / ("mmm-bench-cohort-" + std::to_string(random()));
     fs::create_directories(base / "root");
     const fs::path workflow = base / "one.yaml";
     std::ofstream(workflow) << "mmm_workflow: 1\nname: one\nnodes:\n  - {id: n, type: noop}\n";

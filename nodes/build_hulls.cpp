@@ -22,6 +22,7 @@ workflow::NodeSpec BuildHulls::spec() {
       "Progressive outer hull of every muscle's wrapping surface (edge collapses that only "
       "move the surface outward, least volume first), with a containment check; stored for "
       "wrap_muscles to reuse while the surface is unchanged"}
+      .resources(2, 2048)
       .input<Atlas>("atlas", "The (scaled) atlas")
       .param<std::int64_t>("target_faces", d.target_faces,
                            "Wrapping resolution the hull encloses: each muscle's full mesh "

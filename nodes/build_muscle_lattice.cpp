@@ -48,6 +48,7 @@ workflow::NodeSpec BuildMuscleLattice::spec() {
       "labelled lattice (bones carved out, overlapping segmentations resolved by depth, lost "
       "volume grown back on the free sides), six tetrahedra per cell, touching muscles sharing "
       "their interface nodes"}
+      .resources(2, 4096)
       .input<Atlas>("atlas", "The (scaled) atlas")
       .param<double>("spacing_mm", d.spacing_mm,
                      "Cell edge (mm); 2 keeps every muscle of the default atlas within 1 % of "

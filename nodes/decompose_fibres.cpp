@@ -97,6 +97,7 @@ workflow::NodeSpec DecomposeFibres::spec() {
       "decompose_fibres", 2,
       "Every muscle's volume filled with fibres (slicing, harmonic, mass-spring or cadaver "
       "method), at rest and in every frame of a wrapped motion"}
+      .resources(2, 4096)
       .input<Atlas>("atlas", "The (scaled) atlas")
       .optional_input<MuscleFrames>(
           "wrapped",

@@ -197,6 +197,7 @@ workflow::NodeSpec FitBoneOutlines::spec() {
       "Fit the scaled bones to their outlines on both radiographs (silhouette-based 2D-3D "
       "fit, the scaled shape as prior, the operator's landmarks held); muscles and every "
       "derived element follow the bones"}
+      .resources(2, 3072)
       .input<Atlas>("atlas", "The scaled atlas (scale_atlas)")
       .input<RadiographPair>("radiographs", "The patient's calibrated radiograph pair")
       .optional_input<LandmarkSet>("landmarks", "The operator's landmarks, held in place")

@@ -84,6 +84,7 @@ workflow::NodeSpec ScaleAtlas::spec() {
       "scale_atlas", 1,
       "Morph the atlas onto the patient's landmarks: anatomical first stage, then Laplacian "
       "detail preservation with landmark, joint, attachment and non-penetration terms"}
+      .resources(2, 3072)
       .input<Atlas>("atlas", "The generic atlas")
       .input<LandmarkSet>("landmarks",
                           "femoral_head_centre_r and patella_centre_r (required), "

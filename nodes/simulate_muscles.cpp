@@ -209,6 +209,7 @@ workflow::NodeSpec SimulateMuscles::spec() {
                          "interface, moved by the bones frame by frame (projective dynamics), "
                          "each muscle's volume restored exactly, attachments following their "
                          "bones, surfaces kept out of the bones"}
+          .resources(2, 6144)
           .input<Atlas>("atlas", "The (scaled) atlas the motion drives")
           .input<BonePoses>("motion",
                             "Fused motion of this atlas (fuse_motion with the atlas input)")

@@ -151,6 +151,7 @@ workflow::NodeSpec WrapMuscles::spec() {
                          "volume held exactly (Gauss-Newton "
                          "with a Lagrange multiplier) and contacts found inside the iterations "
                          "keeping it out of the bones"}
+          .resources(2, 4096)
           .input<Atlas>("atlas", "The (scaled) atlas the motion drives")
           .input<BonePoses>("motion",
                             "Fused motion of this atlas (fuse_motion with the atlas input)")

@@ -133,6 +133,16 @@ NodeSpec& NodeSpec::manual(bool is_manual) {
   return *this;
 }
 
+NodeSpec& NodeSpec::resources(int threads, int memory_mb) {
+  if (threads < 1 || memory_mb < 64) {
+    throw InvalidInputError("node type '" + name_ + "': resources need at least 1 thread and " +
+                            "64 MB (got " + std::to_string(threads) + " threads, " +
+                            std::to_string(memory_mb) + " MB)");
+  }
+  resources_ = {threads, memory_mb};
+  return *this;
+}
+
 const PortSpec* NodeSpec::find_input(std::string_view name) const {
   return find_named(inputs_, name);
 }

@@ -56,6 +56,14 @@ struct ParamSpec {
   [[nodiscard]] std::optional<std::string> check(const ParamValue& value) const;
 };
 
+// What one execution of a node type needs on a cluster node (Slurm's
+// --cpus-per-task and --mem): declared by the node type, used by the Slurm
+// executor (slurm_executor.h); local runs ignore it.
+struct NodeResources {
+  int threads = 1;
+  int memory_mb = 2048;
+};
+
 class NodeSpec {
  public:
   NodeSpec(std::string name, int version, std::string description);
@@ -84,10 +92,15 @@ class NodeSpec {
   // computing: the engine opens a task and the study pauses.
   NodeSpec& manual(bool is_manual = true);
 
+  // Threads and memory one execution needs (see NodeResources). Throws
+  // InvalidInputError for threads < 1 or memory < 64 MB.
+  NodeSpec& resources(int threads, int memory_mb);
+
   [[nodiscard]] const std::string& name() const { return name_; }
   [[nodiscard]] int version() const { return version_; }
   [[nodiscard]] const std::string& description() const { return description_; }
   [[nodiscard]] bool is_manual() const { return manual_; }
+  [[nodiscard]] const NodeResources& resources() const { return resources_; }
   [[nodiscard]] const std::vector<PortSpec>& inputs() const { return inputs_; }
   [[nodiscard]] const std::vector<PortSpec>& outputs() const { return outputs_; }
   [[nodiscard]] const std::vector<ParamSpec>& params() const { return params_; }
@@ -105,6 +118,7 @@ class NodeSpec {
   int version_;
   std::string description_;
   bool manual_ = false;
+  NodeResources resources_;
   std::vector<PortSpec> inputs_;
   std::vector<PortSpec> outputs_;
   std::vector<ParamSpec> params_;

@@ -29,8 +29,8 @@ constexpr const char* kStudyDatabase = "study.db";
 double seconds_between(const std::string& from, const std::string& to) {
   const auto parse = [](const std::string& text) -> double {
     std::tm tm{};
-    if (text.size() < 19 || ::strptime(text.substr(0, 19).c_str(), "%Y-%m-%dT%H:%M:%S", &tm) ==
-                                nullptr) {
+    if (text.size() < 19 ||
+        ::strptime(text.substr(0, 19).c_str(), "%Y-%m-%dT%H:%M:%S", &tm) == nullptr) {
       return -1;
     }
     double seconds = static_cast<double>(::timegm(&tm));
@@ -87,8 +87,8 @@ CohortCreateResult create_cohort(const fs::path& root, const CohortCreateOptions
       (void)workflow::Study::create(
           dir, {options.workflow_file, patient.inputs, options.provenance}, registry);
     } catch (const std::exception& failure) {
-      throw IoError(dir, "cohort create: the study of line " + std::to_string(patient.line) +
-                             " (" + patient.id + ") could not be created: " + failure.what() +
+      throw IoError(dir, "cohort create: the study of line " + std::to_string(patient.line) + " (" +
+                             patient.id + ") could not be created: " + failure.what() +
                              "\nhint: the studies before it are created; fix this row and run "
                              "the command again to create the rest");
     }

@@ -23,8 +23,8 @@ namespace {
 bool valid_id(const std::string& id) {
   if (id.empty() || id.size() > 64 || id.front() == '.') return false;
   return std::ranges::all_of(id, [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-           c == '.' || c == '_' || c == '-';
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+           c == '_' || c == '-';
   });
 }
 
@@ -101,18 +101,21 @@ std::vector<CohortPatient> read_cohort_patients(const fs::path& csv,
                                                 const std::map<std::string, std::string>& shared) {
   struct stat info {};
   if (::stat(csv.c_str(), &info) != 0 || !S_ISREG(info.st_mode)) {
-    throw IoError(csv, "no such file; hint: --patients names the CSV file with one row per "
-                       "patient (id and the study inputs)");
+    throw IoError(csv,
+                  "no such file; hint: --patients names the CSV file with one row per "
+                  "patient (id and the study inputs)");
   }
   if (static_cast<std::size_t>(info.st_size) > kMaxCohortCsvBytes) {
-    throw IoError(csv, "is " + std::to_string(info.st_size) + " bytes; a patients file is at most " +
+    throw IoError(csv, "is " + std::to_string(info.st_size) +
+                           " bytes; a patients file is at most " +
                            std::to_string(kMaxCohortCsvBytes) + " (16 MiB)");
   }
   const std::string text = read_file_bytes(csv, static_cast<std::uintmax_t>(info.st_size));
   std::vector<CsvRecord> records = parse_csv(text, csv);
   if (records.empty()) {
-    throw InvalidInputError(csv.string() + ": no header; hint: the first line names the columns, "
-                                           "e.g. id,patient,frontal,lateral");
+    throw InvalidInputError(csv.string() +
+                            ": no header; hint: the first line names the columns, "
+                            "e.g. id,patient,frontal,lateral");
   }
   if (records.size() - 1 > kMaxCohortPatients) {
     throw InvalidInputError(csv.string() + ": " + std::to_string(records.size() - 1) +
@@ -134,8 +137,8 @@ std::vector<CohortPatient> read_cohort_patients(const fs::path& csv,
     const std::string& name = header.fields[k];
     if (name != "id" && workflow.find_input(name) == nullptr) {
       problem(header.line, "column '" + name + "' is not an input of the workflow" +
-                               did_you_mean(name, input_names) + " (its inputs: " +
-                               join_names(input_names) + ")");
+                               did_you_mean(name, input_names) +
+                               " (its inputs: " + join_names(input_names) + ")");
     } else if (!column.emplace(name, k).second) {
       problem(header.line, "column '" + name + "' appears twice");
     }

@@ -27,8 +27,8 @@
 namespace mmm::worklists {
 
 struct GcOptions {
-  bool apply = false;                      // remove (else only report)
-  std::chrono::seconds grace{60 * 60};     // keep blobs whose inode changed since
+  bool apply = false;                   // remove (else only report)
+  std::chrono::seconds grace{60 * 60};  // keep blobs whose inode changed since
 };
 
 struct GcBlob {

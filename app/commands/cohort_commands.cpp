@@ -61,18 +61,17 @@ void run_cohort_create(const CohortCreateArgs& args, const workflow::NodeRegistr
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "cohort " << args.root << ": " << result.created.size() << " studies created";
   if (!result.existing.empty()) std::cout << ", " << result.existing.size() << " already there";
-  std::cout << " in " << std::fixed << std::setprecision(1) << seconds
-            << " s; shared store " << result.store.string() << "\nnext: mmm cohort run "
-            << args.root << " -j 2\n";
+  std::cout << " in " << std::fixed << std::setprecision(1) << seconds << " s; shared store "
+            << result.store.string() << "\nnext: mmm cohort run " << args.root << " -j 2\n";
 }
 
-// The path of this executable, to run `mmm run` with.
-fs::path mmm_executable_path() {
-  std::error_code error;
-  fs::path self = fs::read_symlink("/proc/self/exe", error);
-  if (error) throw IoError("/proc/self/exe", "cannot find this program: " + error.message());
-  return self;
-}
+struct CohortRunArgs {
+  std::string root;
+  int jobs = 2;
+  std::string executor = "local";
+  int node_jobs = 4;  // Slurm jobs out at once per study
+  std::vector<std::string> sbatch_args;
+};
 
 struct CohortRunningStudy {
   std::string study;
@@ -82,7 +81,8 @@ struct CohortRunningStudy {
 // Starts `mmm run DIR --quiet` with its output in `log`; the child dies with
 // the coordinator (PR_SET_PDEATHSIG), so a killed coordinator leaves no run
 // behind that the next one would wait for.
-pid_t start_study_run(const fs::path& exe, const fs::path& study, const fs::path& log) {
+pid_t start_study_run(const fs::path& exe, const fs::path& study, const fs::path& log,
+                      const CohortRunArgs& args) {
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) throw IoError(study, std::string("cannot start a run: fork: ") + strerror(errno));
@@ -96,15 +96,22 @@ pid_t start_study_run(const fs::path& exe, const fs::path& study, const fs::path
   }
   const std::string exe_text = exe.string();
   const std::string dir_text = study.string();
-  std::vector<char*> argv = {const_cast<char*>(exe_text.c_str()), const_cast<char*>("run"),
-                             const_cast<char*>(dir_text.c_str()), const_cast<char*>("--quiet"),
-                             nullptr};
+  std::vector<std::string> words = {exe_text, "run", dir_text, "--quiet"};
+  if (args.executor == "slurm") {
+    words.insert(words.end(), {"--executor", "slurm", "-j", std::to_string(args.node_jobs)});
+    for (const std::string& extra : args.sbatch_args) words.push_back("--sbatch-arg=" + extra);
+  }
+  std::vector<char*> argv;
+  argv.reserve(words.size() + 1);
+  for (std::string& word : words) argv.push_back(word.data());
+  argv.push_back(nullptr);
   ::execv(exe_text.c_str(), argv.data());
   ::_exit(127);
 }
 
 std::string run_outcome_of(int status) {
-  if (WIFSIGNALED(status)) return "failed (killed by signal " + std::to_string(WTERMSIG(status)) + ")";
+  if (WIFSIGNALED(status))
+    return "failed (killed by signal " + std::to_string(WTERMSIG(status)) + ")";
   switch (WEXITSTATUS(status)) {
     case kExitOk:
       return "done";
@@ -117,22 +124,16 @@ std::string run_outcome_of(int status) {
   }
 }
 
-struct CohortRunArgs {
-  std::string root;
-  int jobs = 2;
-};
-
 void run_cohort(const CohortRunArgs& args) {
   const fs::path root = args.root;
   const std::vector<fs::path> studies = worklists::find_studies(root);
   if (studies.empty()) {
-    throw InvalidInputError("no study under " + root.string() +
-                            "; hint: mmm cohort create " + root.string() +
-                            " --workflow WF --patients patients.csv");
+    throw InvalidInputError("no study under " + root.string() + "; hint: mmm cohort create " +
+                            root.string() + " --workflow WF --patients patients.csv");
   }
   const fs::path logs = root / ".mmm-cohort" / "logs";
   fs::create_directories(logs);
-  const fs::path exe = mmm_executable_path();
+  const fs::path exe = this_executable_path();
   std::map<pid_t, CohortRunningStudy> running;
   std::map<std::string, int> counts;
   std::vector<double> seconds;
@@ -145,7 +146,7 @@ void run_cohort(const CohortRunArgs& args) {
       std::string name = dir.lexically_relative(root).generic_string();
       std::string log_name = name;
       std::replace(log_name.begin(), log_name.end(), '/', '_');
-      const pid_t pid = start_study_run(exe, dir, logs / (log_name + ".log"));
+      const pid_t pid = start_study_run(exe, dir, logs / (log_name + ".log"), args);
       running.emplace(pid, CohortRunningStudy{std::move(name), std::chrono::steady_clock::now()});
     }
     int status = 0;
@@ -172,8 +173,8 @@ void run_cohort(const CohortRunArgs& args) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::sort(seconds.begin(), seconds.end());
   std::cout << "cohort " << args.root << ": " << studies.size() << " studies in " << std::fixed
-            << std::setprecision(1) << total << " s (-j " << args.jobs << ", median "
-            << seconds[seconds.size() / 2] << " s per study):";
+            << std::setprecision(1) << total << " s (-j " << args.jobs << ", " << args.executor
+            << ", median " << seconds[seconds.size() / 2] << " s per study):";
   for (const auto& [state, count] : counts) std::cout << ' ' << count << ' ' << state;
   std::cout << "\nlogs: " << logs.string() << "; next: mmm cohort status " << args.root << '\n';
   if (counts.contains("failed")) {
@@ -273,8 +274,9 @@ void register_cohort_commands(CLI::App& app, const workflow::NodeRegistry& regis
       "create", "Create one study per row of a patients file (id and study inputs) under ROOT");
   create->add_option("ROOT", create_args->root, "Root folder of the cohort")->required();
   create->add_option("--workflow,-w", create_args->workflow, "Workflow file (.yaml)")->required();
-  create->add_option("--patients", create_args->patients,
-                     "CSV file: a header 'id,INPUT,...', one row per patient; paths relative to it")
+  create
+      ->add_option("--patients", create_args->patients,
+                   "CSV file: a header 'id,INPUT,...', one row per patient; paths relative to it")
       ->required();
   create->add_option("--input,-i", create_args->inputs,
                      "Study input NAME=VALUE for every patient (e.g. the atlas); repeatable");
@@ -285,7 +287,17 @@ void register_cohort_commands(CLI::App& app, const workflow::NodeRegistry& regis
       "run", "Run every study of ROOT to its next manual step or to the end (re-run to continue)");
   run->add_option("ROOT", run_args->root, "Root folder of the cohort")->required();
   run->add_option("--jobs,-j", run_args->jobs, "Studies run at the same time")
+      ->check(CLI::Range(1, 1024));
+  run->add_option("--executor", run_args->executor,
+                  "Where the nodes run: local (here) or slurm (each node a Slurm job; needs a "
+                  "shared file system)")
+      ->check(CLI::IsMember({"local", "slurm"}));
+  run->add_option("--node-jobs", run_args->node_jobs,
+                  "With slurm: jobs out at once per study (default 4)")
       ->check(CLI::Range(1, 256));
+  run->add_option("--sbatch-arg", run_args->sbatch_args,
+                  "With slurm: an extra sbatch argument for every job (e.g. --partition=short); "
+                  "repeatable");
   run->callback([run_args] { run_cohort(*run_args); });
 
   auto status_args = std::make_shared<CohortStatusArgs>();

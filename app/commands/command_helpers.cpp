@@ -8,6 +8,13 @@ namespace mmm::app {
 
 workflow::Provenance this_program() { return {MMM_VERSION, MMM_GIT_REVISION}; }
 
+std::filesystem::path this_executable_path() {
+  std::error_code error;
+  std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error) throw IoError("/proc/self/exe", "cannot find this program: " + error.message());
+  return self;
+}
+
 std::pair<std::string, std::string> split_assignment(const std::string& text,
                                                      const std::string& what) {
   const std::size_t equals = text.find('=');

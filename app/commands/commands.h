@@ -5,6 +5,7 @@
 // files) sets the exit code instead of throwing.
 
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <string>
 #include <utility>
 
@@ -49,6 +50,12 @@ void register_cohort_commands(CLI::App& app, const workflow::NodeRegistry& regis
 
 // This program's version and build revision, recorded with what it creates.
 workflow::Provenance this_program();
+
+// The path of this executable (/proc/self/exe), for the processes it starts.
+std::filesystem::path this_executable_path();
+
+// mmm worker run-node REQUEST: one node execution for a Slurm job
+void register_worker_commands(CLI::App& app, const workflow::NodeRegistry& registry);
 
 // "NAME=VALUE" -> {NAME, VALUE}; throws InvalidInputError naming `what`
 // otherwise.

@@ -79,6 +79,8 @@ struct RunArgs {
   bool quiet = false;
   bool show_cached = false;
   bool retry_crashed = false;
+  std::string executor = "local";
+  std::vector<std::string> sbatch_args;
 };
 
 void print_summary(const workflow::RunSummary& summary, const std::string& dir) {
@@ -125,6 +127,11 @@ void run_run(const RunArgs& args, const workflow::NodeRegistry& registry) {
   options.retry_crashed = args.retry_crashed;
   options.provenance = this_program();
   options.observer = args.quiet ? nullptr : display.get();
+  if (args.executor == "slurm") {
+    options.executor = workflow::Executor::kSlurm;
+    options.slurm.executable = this_executable_path();
+    options.slurm.sbatch_arguments = args.sbatch_args;
+  }
   const worklists::StudyRunResult result = worklists::run_study_with_tasks(
       study, options, std::chrono::milliseconds(static_cast<long>(args.wait_seconds * 1000)));
   if (result.locked) {
@@ -188,6 +195,13 @@ void register_study_commands(CLI::App& app, const workflow::NodeRegistry& regist
                   "When another runner holds the study, wait up to SECONDS for it (default 5: "
                   "mmm status holds it for a moment)")
       ->check(CLI::Range(0.0, 1e6));
+  run->add_option("--executor", run_args->executor,
+                  "Where the nodes run: local (threads of this process) or slurm (each node a "
+                  "Slurm job, -j of them at once; needs a shared file system)")
+      ->check(CLI::IsMember({"local", "slurm"}));
+  run->add_option("--sbatch-arg", run_args->sbatch_args,
+                  "With --executor slurm: an extra sbatch argument for every job (e.g. "
+                  "--partition=short); repeatable");
   run->add_flag("--quiet,-q", run_args->quiet, "Print only the summary");
   run->add_flag("--show-cached", run_args->show_cached, "Print a line for every reused node");
   run->add_flag("--retry-crashed", run_args->retry_crashed,

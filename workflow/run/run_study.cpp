@@ -17,6 +17,7 @@
 #include "workflow/host_and_time.h"
 #include "workflow/run/crash_marker.h"
 #include "workflow/run/export_outputs.h"
+#include "workflow/run/node_execution.h"
 #include "workflow/run/study_plan.h"
 #include "workflow/study/crash_records.h"
 
@@ -25,26 +26,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using Available = std::map<std::string, std::map<std::string, OutputArtifact>>;
-
-// What a worker hands back when a node finishes.
-struct Completion {
-  std::string node;
-  std::int64_t execution_id = 0;
-  std::map<std::string, OutputArtifact> outputs;
-  std::string error;  // empty: success
-  std::vector<LogLine> logs;
-  double seconds = 0;
-};
-
-// A node handed to the pool.
-struct Job {
-  std::string node;
-  std::int64_t execution_id = 0;
-  std::string cache_key;
-  const NodeType* type = nullptr;
-  std::map<std::string, ArtifactRef> inputs;
-  std::map<std::string, ParamValue> params;
-};
 
 // Completed jobs, from the workers to the scheduler thread.
 class CompletionQueue {
@@ -187,92 +168,6 @@ class DeferredSync {
   Durability before_;
 };
 
-std::vector<std::string> declared_outputs_missing(const NodeSpec& spec,
-                                                  const std::map<std::string, ArtifactRef>& set) {
-  std::vector<std::string> missing;
-  for (const PortSpec& port : spec.outputs()) {
-    if (!set.contains(port.name)) missing.push_back(port.name);
-  }
-  return missing;
-}
-
-// Runs one node in a worker thread; never throws.
-Completion execute(const Job& job, ArtifactStore& artifacts,
-                   const std::filesystem::path& scratch_root,
-                   const std::filesystem::path& crash_marker, RunObserver* observer) {
-  const auto start = Clock::now();
-  Completion completion{job.node, job.execution_id, {}, {}, {}, 0};
-  std::mutex log_mutex;
-  const std::filesystem::path scratch =
-      scratch_root / (std::to_string(job.execution_id) + "-" + job.node);
-  NodeContext::Channels channels;
-  channels.store = [&artifacts](std::string_view bytes) {
-    fault_point("node.store");
-    return artifacts.put(bytes);
-  };
-  channels.store_file = [&artifacts](const std::filesystem::path& file) {
-    fault_point("node.store");
-    return artifacts.put_file(file);
-  };
-  channels.progress = [&](std::int64_t done, std::int64_t total, std::string_view what) {
-    fault_point("node.progress");
-    if (observer != nullptr) observer->node_progress(job.node, done, total, what);
-  };
-  channels.log = [&](LogLevel level, std::string_view message) {
-    {
-      const std::lock_guard lock(log_mutex);
-      completion.logs.push_back({utc_now_precise(), level, std::string(message)});
-    }
-    if (observer != nullptr) observer->node_log(job.node, level, message);
-  };
-  try {
-    // Every input is checked against its content hash right before the node
-    // reads it: an artifact changed in place (by hand, or by a disk fault)
-    // fails the node instead of flowing into its results.
-    for (const auto& [port, ref] : job.inputs) {
-      if (!artifacts.verify(ref.hash)) {
-        throw IoError(ref.path, "input '" + port + "' of node '" + job.node +
-                                    "' is missing or was changed after it was stored (its "
-                                    "content no longer hashes to " +
-                                    ref.hash +
-                                    "); hint: 'mmm audit verify' on the study, then re-run or "
-                                    "restore the node that produced it");
-      }
-    }
-    std::filesystem::create_directories(scratch);
-    NodeContext context(job.type->spec, job.inputs, job.params, scratch, channels);
-    fault_point("node.before_run");
-    {
-      const RunningNodeScope crash_scope(crash_marker, job.node, job.cache_key);
-      job.type->run(context);
-    }
-    fault_point("node.after_run");
-    const std::vector<std::string> missing =
-        declared_outputs_missing(job.type->spec, context.outputs());
-    if (!missing.empty()) {
-      std::string names;
-      for (const std::string& name : missing) names += (names.empty() ? "'" : ", '") + name + "'";
-      throw InvalidInputError("node type '" + job.type->spec.name() +
-                              "' finished without setting output(s) " + names +
-                              " (a bug in the node)");
-    }
-    for (const auto& [port, ref] : context.outputs()) {
-      completion.outputs[port] = {ref.type, ref.hash};
-    }
-  } catch (const std::exception& e) {
-    completion.error = e.what();
-  } catch (...) {
-    completion.error = "unknown exception";
-  }
-  std::error_code ignored;
-  std::filesystem::remove_all(scratch, ignored);
-  if (!completion.error.empty()) {
-    completion.logs.push_back({utc_now_precise(), LogLevel::kError, completion.error});
-  }
-  completion.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  return completion;
-}
-
 void clear_folder(const std::filesystem::path& folder) {
   std::error_code error;
   std::filesystem::create_directories(folder, error);
@@ -290,8 +185,14 @@ class Scheduler {
         options_(options),
         batch_(study.database(), study.artifacts(), options.commit_interval),
         pool_(std::max(1, options.jobs), [this](Job& job) {
-          completions_.push(
-              execute(job, study_.artifacts(), scratch_root_, crash_marker_, options_.observer));
+          if (options_.executor == Executor::kSlurm) {
+            completions_.push(execute_on_slurm(job, study_.artifacts().root(),
+                                               study_.artifacts().pool(), scratch_root_,
+                                               options_.slurm, options_.observer));
+          } else {
+            completions_.push(
+                execute(job, study_.artifacts(), scratch_root_, crash_marker_, options_.observer));
+          }
         }) {}
 
   RunSummary run() {

@@ -33,10 +33,13 @@
 #include <vector>
 
 #include "workflow/run/run_observer.h"
+#include "workflow/run/slurm_executor.h"
 #include "workflow/store/study_lock.h"
 #include "workflow/study/study.h"
 
 namespace mmm::workflow {
+
+enum class Executor { kLocal, kSlurm };
 
 struct RunOptions {
   // Nodes run at the same time (threads); at least 1.
@@ -50,6 +53,11 @@ struct RunOptions {
   // Run nodes that crashed the process before with the same cache key
   // (normally they are reported as failed: crash_records.h).
   bool retry_crashed = false;
+  // Where nodes run: in this process's worker threads, or as Slurm jobs
+  // (slurm_executor.h; `jobs` is then how many jobs are out at once).
+  // Manual nodes are tasks either way.
+  Executor executor = Executor::kLocal;
+  SlurmOptions slurm{};
 };
 
 enum class RunOutcome {

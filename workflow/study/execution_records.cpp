@@ -55,14 +55,6 @@ std::optional<ExecutionRecord> first_row(Statement& select) {
   return read_row(select);
 }
 
-LogLevel level_from_name(const std::string& name) {
-  for (const LogLevel level :
-       {LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarning, LogLevel::kError}) {
-    if (log_level_name(level) == name) return level;
-  }
-  return LogLevel::kInfo;
-}
-
 }  // namespace
 
 std::string_view execution_status_name(ExecutionStatus status) {
@@ -77,6 +69,14 @@ std::string_view execution_status_name(ExecutionStatus status) {
       return "interrupted";
   }
   return "unknown";
+}
+
+LogLevel log_level_from_name(std::string_view name) {
+  for (const LogLevel level :
+       {LogLevel::kDebug, LogLevel::kInfo, LogLevel::kWarning, LogLevel::kError}) {
+    if (log_level_name(level) == name) return level;
+  }
+  return LogLevel::kInfo;
 }
 
 std::string_view log_level_name(LogLevel level) {
@@ -197,7 +197,7 @@ std::vector<LogLine> execution_logs(Database& database, std::int64_t id) {
   std::vector<LogLine> lines;
   while (select.step()) {
     lines.push_back(
-        {select.column_text(0), level_from_name(select.column_text(1)), select.column_text(2)});
+        {select.column_text(0), log_level_from_name(select.column_text(1)), select.column_text(2)});
   }
   return lines;
 }

@@ -61,6 +61,8 @@ struct LogLine {
   std::string message;
 };
 std::string_view log_level_name(LogLevel level);
+// The level of a name log_level_name gives; kInfo for any other.
+LogLevel log_level_from_name(std::string_view name);
 
 // Inserts `record` (id ignored) and returns its id.
 std::int64_t insert_execution(Database& database, const ExecutionRecord& record);
