@@ -3,7 +3,7 @@
 
 #include "worklists/cohort.h"
 
-#include <signal.h>
+#include <csignal>
 
 #include <cerrno>
 
@@ -25,21 +25,11 @@ namespace {
 
 constexpr const char* kStudyDatabase = "study.db";
 
-// Seconds between two "2026-11-22T14:03:00.123Z" times (0 when unreadable).
+// Seconds between two recorded times (0 when either is unreadable).
 double seconds_between(const std::string& from, const std::string& to) {
-  const auto parse = [](const std::string& text) -> double {
-    std::tm tm{};
-    if (text.size() < 19 ||
-        ::strptime(text.substr(0, 19).c_str(), "%Y-%m-%dT%H:%M:%S", &tm) == nullptr) {
-      return -1;
-    }
-    double seconds = static_cast<double>(::timegm(&tm));
-    if (text.size() > 20 && text[19] == '.') seconds += std::stod("0" + text.substr(19, 4));
-    return seconds;
-  };
-  const double a = parse(from);
-  const double b = parse(to);
-  return a < 0 || b < 0 ? 0.0 : b - a;
+  const double a = utc_seconds(from);
+  const double b = utc_seconds(to);
+  return a <= 0 || b <= 0 ? 0.0 : b - a;
 }
 
 // A runner holds the study: its lock file names a live process of this

@@ -31,18 +31,6 @@ void collect(const fs::path& dir, int depth, std::vector<fs::path>& studies) {
   }
 }
 
-// Seconds since the epoch of "2026-11-22T14:03:00.123Z" (0 when unreadable).
-double utc_seconds(const std::string& text) {
-  std::tm tm{};
-  if (text.size() < 19 ||
-      ::strptime(text.substr(0, 19).c_str(), "%Y-%m-%dT%H:%M:%S", &tm) == nullptr) {
-    return 0;
-  }
-  auto seconds = static_cast<double>(::timegm(&tm));
-  if (text.size() > 20 && text[19] == '.') seconds += std::stod("0" + text.substr(19, 4));
-  return seconds;
-}
-
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
@@ -58,6 +46,17 @@ std::string patient_of(workflow::Database& database, const fs::path& dir) {
 }
 
 }  // namespace
+
+double utc_seconds(const std::string& text) {
+  std::tm tm{};
+  if (text.size() < 19 ||
+      ::strptime(text.substr(0, 19).c_str(), "%Y-%m-%dT%H:%M:%S", &tm) == nullptr) {
+    return 0;
+  }
+  auto seconds = static_cast<double>(::timegm(&tm));
+  if (text.size() > 20 && text[19] == '.') seconds += std::stod("0" + text.substr(19, 4));
+  return seconds;
+}
 
 std::vector<fs::path> find_studies(const fs::path& root) {
   std::error_code error;

@@ -45,6 +45,10 @@ std::vector<WorklistEntry> list_worklist(const std::filesystem::path& root,
 // are named, none is picked) or the prefix is ambiguous (listing the matches).
 WorklistEntry locate_task(const std::filesystem::path& root, const std::string& given);
 
+// Seconds since the epoch of a recorded time, "2026-11-22T14:03:00.123Z"
+// (0 when unreadable).
+double utc_seconds(const std::string& text);
+
 // "3 h 12 min", "45 s", "2 d 4 h": an age for people.
 std::string format_age(double seconds);
 

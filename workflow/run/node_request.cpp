@@ -182,7 +182,7 @@ Completion run_node_request(const NodeRequest& request) {
   ArtifactStore artifacts(request.artifacts);
   if (request.pool) artifacts.share_with(*request.pool);
   fs::create_directories(request.scratch);
-  const Completion completion =
+  Completion completion =
       execute(request.job, artifacts, request.scratch, request.scratch / "crash-marker", nullptr);
   write_file_atomically(request.result, completion_text(completion, host_name()), "a node result");
   return completion;

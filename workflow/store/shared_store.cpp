@@ -21,7 +21,7 @@ std::optional<fs::path> find_shared_store(const fs::path& study_dir) {
 }
 
 fs::path create_shared_store(const fs::path& root) {
-  const fs::path store = root / kSharedStoreFolder;
+  fs::path store = root / kSharedStoreFolder;
   std::error_code error;
   fs::create_directories(store, error);
   if (!fs::is_directory(store)) {
