@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "app/commands/commands.h"
+#include "app/report/cohort_report_page.h"
 #include "core/errors.h"
 #include "worklists/cohort.h"
 #include "worklists/root_gc.h"
@@ -224,6 +225,19 @@ void run_cohort_status(const CohortStatusArgs& args) {
   }
 }
 
+struct CohortReportArgs {
+  std::string root;
+  std::string out;
+};
+
+void run_cohort_report(const CohortReportArgs& args) {
+  const fs::path out =
+      args.out.empty() ? fs::path(args.root) / "cohort_report" : fs::path(args.out);
+  const report::CohortReportResult result = report::write_cohort_report(args.root, out);
+  std::cout << "cohort report of " << result.studies << " studies (" << result.outliers
+            << " outlier figures): " << result.index.string() << '\n';
+}
+
 struct CollectArgs {
   std::string root;
   bool apply = false;
@@ -306,6 +320,15 @@ void register_cohort_commands(CLI::App& app, const workflow::NodeRegistry& regis
   status->add_option("ROOT", status_args->root, "Root folder of the cohort")->required();
   status->add_flag("--json", status_args->json, "Machine-readable output");
   status->callback([status_args] { run_cohort_status(*status_args); });
+
+  auto report_args = std::make_shared<CohortReportArgs>();
+  auto* report_command = cohort->add_subcommand(
+      "report",
+      "One offline page across the cohort: distributions, outliers, operators, throughput");
+  report_command->add_option("ROOT", report_args->root, "Root folder of the cohort")->required();
+  report_command->add_option("-o,--out", report_args->out,
+                             "Report folder (default: ROOT/cohort_report)");
+  report_command->callback([report_args] { run_cohort_report(*report_args); });
 
   auto gc_args = std::make_shared<CollectArgs>();
   auto* gc = app.add_subcommand(

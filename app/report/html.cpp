@@ -33,4 +33,14 @@ std::string fixed(double value, int decimals) {
   return s.str();
 }
 
+std::string_view report_style() {
+  return "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}"
+         "table{border-collapse:collapse;margin:.5em 0 1em}td,th{border:1px solid #ccc;padding:2px "
+         "8px;"
+         "font-size:90%;text-align:left}th{background:#f0f0f0}figure{margin:1em 0}"
+         "figure img,figure svg{max-width:100%;height:auto}figure "
+         "img{max-height:90vh}figcaption{color:#555;font-size:90%}"
+         ".pending{color:#a60}";
+}
+
 }  // namespace mmm::app::report

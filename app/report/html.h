@@ -12,6 +12,9 @@ namespace mmm::app::report {
 std::string html_table(const std::vector<std::string>& header,
                        const std::vector<std::vector<std::string>>& rows);
 
+// The pages' shared style sheet (a <style> element's content).
+std::string_view report_style();
+
 // A number with `decimals` digits after the point ("-" for NaN or infinity).
 std::string fixed(double value, int decimals);
 

@@ -445,14 +445,6 @@ void provenance_section(Page& page, const json& status) {
   page.end_section();
 }
 
-constexpr const char* kStyle =
-    "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}"
-    "table{border-collapse:collapse;margin:.5em 0 1em}td,th{border:1px solid #ccc;padding:2px 8px;"
-    "font-size:90%;text-align:left}th{background:#f0f0f0}figure{margin:1em 0}"
-    "figure img,figure svg{max-width:100%;height:auto}figure "
-    "img{max-height:90vh}figcaption{color:#555;font-size:90%}"
-    ".pending{color:#a60}";
-
 }  // namespace
 
 ReportResult write_study_report(const ReportInput& input, const fs::path& out) {
@@ -471,8 +463,8 @@ ReportResult write_study_report(const ReportInput& input, const fs::path& out) {
   const std::string html =
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       "<title>" +
-      xml_escaped(title) + "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n<h1>" +
-      xml_escaped(title) +
+      xml_escaped(title) + "</title>\n<style>" + std::string(report_style()) +
+      "</style>\n</head>\n<body>\n<h1>" + xml_escaped(title) +
       "</h1>\n<p>State: " + xml_escaped(input.status.value("state", std::string())) +
       ". Study folder: " + xml_escaped(study_dir.string()) + "</p>\n" + page.body() +
       "</body>\n</html>\n";

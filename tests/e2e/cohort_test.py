@@ -16,6 +16,8 @@ tests/e2e/cohort_workflow.yaml (landmarks, scaling, outline fitting):
      before the kill ran again (one 'done' execution per cache key), and
      what was killed is recorded as interrupted and ran again.
   6. `mmm gc ROOT` finds nothing to remove; the outputs are intact.
+  7. `mmm cohort report ROOT`: both studies done, their contour residuals,
+     the operator's landmark errors.
 
 Usage: cohort_test.py --mmm MMM --source REPO --atlas ATLAS --patient PATIENT --work DIR
 """
@@ -181,6 +183,14 @@ def main():
                             log).stdout)
     if report["study_blobs"] or report["shared_blobs"]:
         fail(f"gc would remove referenced blobs: {report}")
+    # 7. The cohort's report.
+    run([args.mmm, "cohort", "report", root], log)
+    page = (root / "cohort_report" / "index.html").read_text()
+    for expected in ('<h2 id="figures">', "mean contour residual", "2 of 2 studies done",
+                     "<td>bot</td><td>2</td>"):
+        if expected not in page:
+            fail(f"the cohort report lacks {expected!r}")
+
     print(f"cohort: 2 studies done after a SIGKILL of the coordinator ({interrupted} interrupted "
           f"execution(s) re-run, nothing finished redone); "
           f"{report['kept_bytes'] >> 20} MB under the root, nothing to collect")
