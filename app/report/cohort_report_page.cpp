@@ -5,6 +5,7 @@
 #include "app/report/cohort_report_page.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -37,7 +38,7 @@ struct FigureSpec {
 };
 
 // In page order.
-constexpr FigureSpec kFigures[] = {
+constexpr std::array<FigureSpec, 11> kFigures = {{
     {"femur_length_factor", "scaling", "femur length factor", "", 3},
     {"tibia_length_factor", "scaling", "tibia length factor", "", 3},
     {"stretch_warnings", "scaling", "implausible stretch warnings", "", 0},
@@ -49,7 +50,7 @@ constexpr FigureSpec kFigures[] = {
     {"depth_in_muscles_mm", "wrapping", "deepest vertex in another muscle", "mm", 2},
     {"fibres_inside", "fibres", "fraction of fibre points inside the muscle (worst)", "", 4},
     {"compute_seconds", "throughput", "compute time of the study's runs", "s", 1},
-};
+}};
 
 double number_or_nan(const CohortJson& value) {
   return value.is_number() ? value.get<double>() : std::nan("");
@@ -185,16 +186,15 @@ std::string strip_svg(const std::vector<std::pair<std::string, double>>& values,
     return kPad + (d.max > d.min ? (v - d.min) / span : 0.5) * (kWidth - 2 * kPad);
   };
   std::string svg =
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"360\" height=\"26\" "
-      "viewBox=\"0 0 360 26\">";
-  svg += "<rect x=\"" + fixed(x(d.p25), 1) + "\" y=\"5\" width=\"" +
+      R"(<svg xmlns="http://www.w3.org/2000/svg" width="360" height="26" viewBox="0 0 360 26">)";
+  svg += R"(<rect x=")" + fixed(x(d.p25), 1) + R"(" y="5" width=")" +
          fixed(std::max(1.0, x(d.p75) - x(d.p25)), 1) +
-         "\" height=\"16\" fill=\"#dde\" stroke=\"#99a\"/>";
-  svg += "<line x1=\"" + fixed(x(d.median), 1) + "\" x2=\"" + fixed(x(d.median), 1) +
-         "\" y1=\"3\" y2=\"23\" stroke=\"#225\" stroke-width=\"2\"/>";
+         R"(" height="16" fill="#dde" stroke="#99a"/>)";
+  svg += R"(<line x1=")" + fixed(x(d.median), 1) + R"(" x2=")" + fixed(x(d.median), 1) +
+         R"(" y1="3" y2="23" stroke="#225" stroke-width="2"/>)";
   for (const auto& [study, value] : values) {
-    svg += "<circle cx=\"" + fixed(x(value), 1) + "\" cy=\"13\" r=\"3\" fill=\"" +
-           (is_outlier(value, d) ? "#c22" : "#557") + "\" fill-opacity=\"0.7\"><title>" +
+    svg += R"(<circle cx=")" + fixed(x(value), 1) + R"(" cy="13" r="3" fill=")" +
+           (is_outlier(value, d) ? "#c22" : "#557") + R"(" fill-opacity="0.7"><title>)" +
            xml_escaped(study) + ": " + fixed(value, 4) + "</title></circle>";
   }
   return svg + "</svg>";
@@ -257,6 +257,7 @@ CohortReportResult write_cohort_report(const fs::path& root, const fs::path& out
   }
   body += heading("throughput", "Throughput");
   std::vector<std::vector<std::string>> state_rows;
+  state_rows.reserve(states.size());
   for (const auto& [state, count] : states) state_rows.push_back({state, std::to_string(count)});
   body += html_table({"state", "studies"}, state_rows);
   const double span = first.empty() || last.empty()
@@ -333,6 +334,7 @@ CohortReportResult write_cohort_report(const fs::path& root, const fs::path& out
     errors.insert(errors.end(), study.landmark_errors_mm.begin(), study.landmark_errors_mm.end());
   }
   std::vector<std::vector<std::string>> operator_rows;
+  operator_rows.reserve(by_operator.size());
   for (const auto& [who, errors] : by_operator) {
     operator_rows.push_back({who, std::to_string(sets.at(who)), std::to_string(errors.size()),
                              fixed(percentile(errors, 0.5), 2), fixed(percentile(errors, 0.95), 2),
