@@ -1,43 +1,39 @@
-#!/ usr / bin / env bash
-#A single - node Slurm cluster on this machine, for the tests : munged,
-#slurmctld and slurmd started from a private folder(no system service, no
-#cgroups, SlurmUser root or the current user), and stopped again.
+#!/usr/bin/env bash
+# A single-node Slurm cluster on this machine, for the tests: munged,
+# slurmctld and slurmd started from a private folder (no system service, no
+# cgroups, SlurmUser root or the current user), and stopped again.
 #
-#tests / slurm / local_cluster.sh start DIR prints "export SLURM_CONF=DIR/slurm.conf"
-#tests / slurm / local_cluster.sh stop DIR
+#   tests/slurm/local_cluster.sh start DIR   prints "export SLURM_CONF=DIR/slurm.conf"
+#   tests/slurm/local_cluster.sh stop DIR
 #
-#Needs Debian's slurm-wlm and munge (make deps installs them). The
-#cluster's one node is this host with its CPUs and memory; one partition,
-# `mmm`.Accounting is off(no slurmdbd) : finished jobs are followed with
-# `scontrol show job` while Slurm keeps them(MinJobAge 600 s).
-set - euo pipefail action = ${1 : ? usage : local_cluster.sh start | stop DIR} dir =
-${2 : ? usage : local_cluster.sh start | stop DIR} mkdir - p "$dir" dir = $(cd "$dir" && pwd)
+# Needs Debian's slurm-wlm and munge (make deps installs them). The
+# cluster's one node is this host with its CPUs and memory; one partition,
+# `mmm`. Accounting is off (no slurmdbd): finished jobs are followed with
+# `scontrol show job` while Slurm keeps them (MinJobAge 600 s). The scheduler
+# runs every second and starts a batch job as soon as it is submitted.
+set -euo pipefail
+action=${1:?usage: local_cluster.sh start|stop DIR}
+dir=${2:?usage: local_cluster.sh start|stop DIR}
+mkdir -p "$dir"
+dir=$(cd "$dir" && pwd)
 
-    stop() {
-  for
-    pidfile in
-        "$dir/slurmd.pid"
-        "$dir/slurmctld.pid"
-        "$dir/munged.pid";
-  do
+stop() {
+  for pidfile in "$dir/slurmd.pid" "$dir/slurmctld.pid" "$dir/munged.pid"; do
     [[ -s $pidfile ]] || continue
     pid=$(cat "$pidfile")
     kill "$pid" 2>/dev/null || true
-    for _ in $(seq 50);
-  do kill - 0 "$pid" 2 > / dev / null || break;
-  sleep 0.1;
-  done kill - 9 "$pid" 2 > / dev / null || true rm - f "$pidfile" done
+    for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
+    kill -9 "$pid" 2>/dev/null || true
+    rm -f "$pidfile"
+  done
 }
 
-if
-  [[$action == stop]];
-then stop exit 0 fi [[$action == start]] || {
-  echo "local_cluster.sh: start or stop, not '$action'" > &2;
-  exit 2;
-}
-for
-  tool in munged slurmctld slurmd sbatch;
-do
+if [[ $action == stop ]]; then
+  stop
+  exit 0
+fi
+[[ $action == start ]] || { echo "local_cluster.sh: start or stop, not '$action'" >&2; exit 2; }
+for tool in munged slurmctld slurmd sbatch; do
   command -v "$tool" >/dev/null || [[ -x /usr/sbin/$tool ]] || {
     echo "local_cluster.sh: $tool is missing; install slurm-wlm and munge (make deps)" >&2
     exit 1
@@ -93,12 +89,13 @@ CONF
 export SLURM_CONF=$dir/slurm.conf
 /usr/sbin/slurmctld -f "$dir/slurm.conf" -i
 /usr/sbin/slurmd -f "$dir/slurm.conf"
-for _ in $(seq 100);
-do
-  state = $(sinfo - h - N - o % T 2 > / dev / null | head - 1 || true)
-              [[$state == idle || $state == mixed || $state == allocated]] &&
-          break sleep 0.2 done if [[$state != idle && $state != mixed && $state != allocated]];
-then
+state=unknown
+for _ in $(seq 100); do
+  state=$(sinfo -h -N -o %T 2>/dev/null | head -1 || true)
+  [[ $state == idle || $state == mixed || $state == allocated ]] && break
+  sleep 0.2
+done
+if [[ $state != idle && $state != mixed && $state != allocated ]]; then
   echo "local_cluster.sh: the node did not come up (state '$state'); logs in $dir/log" >&2
   tail -20 "$dir/log/slurmctld.log" "$dir/log/slurmd.log" >&2 || true
   stop

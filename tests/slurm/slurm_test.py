@@ -1,4 +1,4 @@
-#!/ usr / bin / env python3
+#!/usr/bin/env python3
 """Node executions as Slurm jobs, on a real single-node Slurm cluster started
 here (tests/slurm/local_cluster.sh: munged, slurmctld, slurmd on localhost).
 
@@ -51,10 +51,13 @@ class Runner:
 def node_seconds(run, study, node):
     """The time of the node's last execution, from `mmm explain`."""
     text = run([run.args.mmm, "explain", study, node]).stdout
+    seconds = None
     for line in text.splitlines():
         parts = line.split()
         if len(parts) > 4 and parts[0].startswith("#") and parts[1] == "done":
             seconds = float(parts[3])
+    if seconds is None:
+        fail(f"no finished execution of {node} in {study}:\n{text}")
     return seconds
 
 
@@ -84,7 +87,7 @@ def main():
             run([args.mmm, "study", "create", path, "-w", workflow, "-i", f"surface={surface}"])
             return path
 
-# 1. Slurm against local.
+        # 1. Slurm against local.
         local, remote = study("local"), study("slurm")
         run([args.mmm, "run", local])
         run([args.mmm, "run", remote, "--executor", "slurm"])
@@ -98,7 +101,7 @@ def main():
         overhead = [node_seconds(run, remote, n) - node_seconds(run, local, n)
                     for n in ("load", "simplify", "measure")]
 
-# 2. scancel.
+        # 2. scancel.
         cancelled = study("cancelled")
         run(["scontrol", "update", "PartitionName=mmm", "State=DOWN"])
         runner = subprocess.Popen([str(args.mmm), "run", str(cancelled), "--executor", "slurm"],
@@ -122,7 +125,7 @@ def main():
         if "failed" not in history or "done" not in history:
             fail(f"the cancelled execution and its re-run are not both recorded:\n{history}")
 
-# 3. A cohort on Slurm.
+        # 3. A cohort on Slurm.
         root = args.work / "cohort"
         patients = args.work / "patients.csv"
         patients.write_text(f"id,surface\na,{surface}\nb,{surface}\n")
