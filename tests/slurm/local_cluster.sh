@@ -8,7 +8,7 @@
 #
 # Needs Debian's slurm-wlm and munge (make deps installs them). The
 # cluster's one node is this host with its CPUs and memory; one partition,
-# `mmm`. Accounting is off (no slurmdbd): finished jobs are followed with
+# `mmm`, reached at 127.0.0.1 (no name lookup needed). Accounting is off (no slurmdbd): finished jobs are followed with
 # `scontrol show job` while Slurm keeps them (MinJobAge 600 s). The scheduler
 # runs every second and starts a batch job as soon as it is submitted.
 set -euo pipefail
@@ -53,7 +53,7 @@ chmod 400 "$dir/munge/munge.key"
   --force
 cat >"$dir/slurm.conf" <<CONF
 ClusterName=mmmtest
-SlurmctldHost=$host
+SlurmctldHost=$host(127.0.0.1)
 SlurmUser=$user
 SlurmdUser=$user
 AuthType=auth/munge
@@ -83,7 +83,7 @@ SlurmdTimeout=30
 InactiveLimit=0
 KillWait=5
 MpiDefault=none
-NodeName=$host CPUs=$cpus RealMemory=$memory State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$memory State=UNKNOWN
 PartitionName=mmm Nodes=$host Default=YES MaxTime=INFINITE State=UP OverSubscribe=NO
 CONF
 export SLURM_CONF=$dir/slurm.conf
