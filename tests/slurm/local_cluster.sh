@@ -7,10 +7,11 @@
 #   tests/slurm/local_cluster.sh stop DIR
 #
 # Needs Debian's slurm-wlm and munge (make deps installs them). The
-# cluster's one node is this host with its CPUs and memory; one partition,
-# `mmm`, reached at 127.0.0.1 (no name lookup needed). Accounting is off (no slurmdbd): finished jobs are followed with
-# `scontrol show job` while Slurm keeps them (MinJobAge 600 s). The scheduler
-# runs every second and starts a batch job as soon as it is submitted.
+# cluster's one node is this host with its CPUs and memory, reached at
+# 127.0.0.1 (no name lookup needed); one partition, `mmm`. Accounting is off
+# (no slurmdbd): finished jobs are followed with `scontrol show job` while
+# Slurm keeps them (MinJobAge 600 s). The scheduler runs every second and
+# starts a batch job as soon as it is submitted.
 set -euo pipefail
 action=${1:?usage: local_cluster.sh start|stop DIR}
 dir=${2:?usage: local_cluster.sh start|stop DIR}

@@ -44,8 +44,9 @@ void make_study(const fs::path& dir, double femur_factor, const std::string& fin
   test::write_file(dir / "outputs" / "scaling_report.json",
                    R"({"length_factor": {"femur_r": )" + std::to_string(femur_factor) +
                        R"(, "tibia_r": 1.0}, "warnings": []})");
-  test::write_file(dir / "outputs" / "landmarks.json",
-                   R"({"landmarks": [{"name": "a", "reprojection_error_mm": {"frontal": 0.5, "lateral": 1.5}}]})");
+  test::write_file(
+      dir / "outputs" / "landmarks.json",
+      R"({"landmarks": [{"name": "a", "reprojection_error_mm": {"frontal": 0.5, "lateral": 1.5}}]})");
 }
 
 TEST(CohortReportTest, DistributionsOutliersOperatorsAndThroughput) {
