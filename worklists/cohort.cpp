@@ -97,15 +97,18 @@ CohortStatus cohort_status(const fs::path& root) {
         "SELECT id, status, started_at, COALESCE(finished_at, '') FROM runs ORDER BY id DESC "
         "LIMIT 1");
     std::int64_t run_id = 0;
+    const bool running = runner_alive(dir);
     if (!last.step()) {
-      study.state = runner_alive(dir) ? "running" : "created";
+      study.state = running ? "running" : "created";
     } else {
       run_id = last.column_int64(0);
       study.state = last.column_text(1);
       study.last_run_finished_at = last.column_text(3);
       study.last_run_seconds = seconds_between(last.column_text(2), study.last_run_finished_at);
-      if (study.last_run_finished_at.empty() || runner_alive(dir)) {
-        study.state = runner_alive(dir) ? "running" : "interrupted";
+      if (running) {
+        study.state = "running";
+      } else if (study.last_run_finished_at.empty()) {
+        study.state = "interrupted";
       }
     }
     if (study.state == "failed") {

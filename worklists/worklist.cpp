@@ -35,6 +35,8 @@ double now_seconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
+}  // namespace
+
 std::string patient_of(workflow::Database& database, const fs::path& dir) {
   workflow::Statement select =
       database.prepare("SELECT given FROM inputs WHERE name = 'patient' AND is_file = 0");
@@ -44,8 +46,6 @@ std::string patient_of(workflow::Database& database, const fs::path& dir) {
   }
   return dir.filename().string();
 }
-
-}  // namespace
 
 double utc_seconds(const std::string& text) {
   std::tm tm{};

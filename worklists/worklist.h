@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "workflow/store/sqlite.h"
 #include "worklists/task.h"
 
 namespace mmm::worklists {
@@ -44,6 +45,10 @@ std::vector<WorklistEntry> list_worklist(const std::filesystem::path& root,
 // in several studies (a copied study folder keeps its task ids: the studies
 // are named, none is picked) or the prefix is ambiguous (listing the matches).
 WorklistEntry locate_task(const std::filesystem::path& root, const std::string& given);
+
+// The study input 'patient' (its code on worklists and reports) when the
+// study has one, else the study folder's name.
+std::string patient_of(workflow::Database& database, const std::filesystem::path& dir);
 
 // Seconds since the epoch of a recorded time, "2026-11-22T14:03:00.123Z"
 // (0 when unreadable).

@@ -132,10 +132,7 @@ void read_database(const fs::path& dir, CohortStudyFigures& study) {
     }
   }
   if (study.compute_seconds > 0) put(study, "compute_seconds", study.compute_seconds);
-  workflow::Statement patient =
-      database.prepare("SELECT given FROM inputs WHERE name = 'patient' AND is_file = 0");
-  study.patient = patient.step() ? patient.column_text(0) : std::string();
-  if (study.patient.empty()) study.patient = dir.filename().string();
+  study.patient = worklists::patient_of(database, dir);
   if (worklists::tasks_table_exists(database)) {
     workflow::Statement placed = database.prepare(
         "SELECT submitted_by FROM tasks WHERE node_type = 'landmark_station' AND state = "
