@@ -71,7 +71,7 @@ struct CohortRunArgs {
   int jobs = 2;
   std::string executor = "local";
   int node_jobs = 4;  // Slurm jobs out at once per study
-  std::vector<std::string> sbatch_args;
+  std::vector<std::string> slurm_args;
 };
 
 struct CohortRunningStudy {
@@ -100,7 +100,7 @@ pid_t start_study_run(const fs::path& exe, const fs::path& study, const fs::path
   std::vector<std::string> words = {exe_text, "run", dir_text, "--quiet"};
   if (args.executor == "slurm") {
     words.insert(words.end(), {"--executor", "slurm", "-j", std::to_string(args.node_jobs)});
-    for (const std::string& extra : args.sbatch_args) words.push_back("--sbatch-arg=" + extra);
+    for (const std::string& extra : args.slurm_args) words.push_back("--slurm-arg=" + extra);
   }
   std::vector<char*> argv;
   argv.reserve(words.size() + 1);
@@ -309,8 +309,8 @@ void register_cohort_commands(CLI::App& app, const workflow::NodeRegistry& regis
   run->add_option("--node-jobs", run_args->node_jobs,
                   "With slurm: jobs out at once per study (default 4)")
       ->check(CLI::Range(1, 256));
-  run->add_option("--sbatch-arg", run_args->sbatch_args,
-                  "With slurm: an extra sbatch argument for every job (e.g. --partition=short); "
+  run->add_option("--slurm-arg", run_args->slurm_args,
+                  "With slurm: an extra srun argument for every job (e.g. --partition=short); "
                   "repeatable");
   run->callback([run_args] { run_cohort(*run_args); });
 

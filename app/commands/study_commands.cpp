@@ -80,7 +80,7 @@ struct RunArgs {
   bool show_cached = false;
   bool retry_crashed = false;
   std::string executor = "local";
-  std::vector<std::string> sbatch_args;
+  std::vector<std::string> slurm_args;
 };
 
 void print_summary(const workflow::RunSummary& summary, const std::string& dir) {
@@ -130,7 +130,7 @@ void run_run(const RunArgs& args, const workflow::NodeRegistry& registry) {
   if (args.executor == "slurm") {
     options.executor = workflow::Executor::kSlurm;
     options.slurm.executable = this_executable_path();
-    options.slurm.sbatch_arguments = args.sbatch_args;
+    options.slurm.srun_arguments = args.slurm_args;
   }
   const worklists::StudyRunResult result = worklists::run_study_with_tasks(
       study, options, std::chrono::milliseconds(static_cast<long>(args.wait_seconds * 1000)));
@@ -199,9 +199,9 @@ void register_study_commands(CLI::App& app, const workflow::NodeRegistry& regist
                   "Where the nodes run: local (threads of this process) or slurm (each node a "
                   "Slurm job, -j of them at once; needs a shared file system)")
       ->check(CLI::IsMember({"local", "slurm"}));
-  run->add_option("--sbatch-arg", run_args->sbatch_args,
-                  "With --executor slurm: an extra sbatch argument for every job (e.g. "
-                  "--partition=short); repeatable");
+  run->add_option("--slurm-arg", run_args->slurm_args,
+                  "With --executor slurm: an extra srun argument for every job (e.g. "
+                  "--partition=short, --time=60); repeatable");
   run->add_flag("--quiet,-q", run_args->quiet, "Print only the summary");
   run->add_flag("--show-cached", run_args->show_cached, "Print a line for every reused node");
   run->add_flag("--retry-crashed", run_args->retry_crashed,

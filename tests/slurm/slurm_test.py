@@ -10,8 +10,10 @@ here (tests/slurm/local_cluster.sh: munged, slurmctld, slurmd on localhost).
      in the queue): the run fails naming the job's state, CANCELLED; run
      again with the partition up, the node is submitted again and the study
      finishes.
-  3. `mmm cohort run --executor slurm` on two studies: both done.
-  4. The overhead: per node, the Slurm run's time less the local run's
+  3. A killed coordinator (SIGKILL, its job waiting in the queue) leaves no
+     job behind: Slurm lists the job as CANCELLED at once.
+  4. `mmm cohort run --executor slurm` on two studies: both done.
+  5. The overhead: per node, the Slurm run's time less the local run's
      (printed; the median is stated in docs/benchmarks.md).
 
 Usage: slurm_test.py --mmm MMM --source REPO --data DATA --work DIR
@@ -125,7 +127,31 @@ def main():
         if "failed" not in history or "done" not in history:
             fail(f"the cancelled execution and its re-run are not both recorded:\n{history}")
 
-        # 3. A cohort on Slurm.
+        # 3. The coordinator killed while its job waits: the job goes too.
+        orphan = study("orphan")
+        run(["scontrol", "update", "PartitionName=mmm", "State=DOWN"])
+        runner = subprocess.Popen([str(args.mmm), "run", str(orphan), "--executor", "slurm"],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+        waiting = None
+        deadline = time.time() + 60
+        while waiting is None and time.time() < deadline:
+            queued = run(["squeue", "-h", "-n", "mmm-load", "-t", "PENDING", "-o", "%i"])
+            waiting = queued.stdout.split()[0] if queued.stdout.split() else None
+            time.sleep(0.1)
+        if waiting is None:
+            fail("the orphan test's job never appeared in the queue")
+        runner.kill()
+        runner.wait()
+        state = ""
+        deadline = time.time() + 30
+        while state != "CANCELLED" and time.time() < deadline:
+            state = run(["squeue", "-h", "-t", "all", "-j", waiting, "-o", "%T"]).stdout.strip()
+            time.sleep(0.1)
+        run(["scontrol", "update", "PartitionName=mmm", "State=UP"])
+        if state != "CANCELLED":
+            fail(f"job {waiting} outlived its killed coordinator (state {state})")
+
+        # 4. A cohort on Slurm.
         root = args.work / "cohort"
         patients = args.work / "patients.csv"
         patients.write_text(f"id,surface\na,{surface}\nb,{surface}\n")
@@ -135,7 +161,8 @@ def main():
         if not status.startswith("2 studies: 2 done"):
             fail(f"the Slurm cohort is not done:\n{status}")
         print(f"slurm: 3 nodes as jobs, outputs identical to a local run; a scancelled job "
-              f"recorded ({job}) and re-run; a 2-study cohort done; overhead per node "
+              f"recorded ({job}) and re-run; a killed coordinator's job cancelled "
+              f"({waiting}); a 2-study cohort done; overhead per node "
               f"{', '.join(f'{o:.2f}' for o in overhead)} s (median "
               f"{statistics.median(overhead):.2f} s)")
     finally:

@@ -2,11 +2,9 @@
 
 #include <sys/stat.h>
 
-#include <algorithm>
-#include <fstream>
-#include <set>
+#include <array>
+#include <csignal>
 #include <sstream>
-#include <thread>
 
 #include "core/errors.h"
 #include "core/file_bytes.h"
@@ -22,13 +20,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Job states after which a job runs no more (squeue may still list it a moment).
-const std::set<std::string, std::less<>>& final_states() {
-  static const std::set<std::string, std::less<>> states = {
-      "BOOT_FAIL", "CANCELLED", "COMPLETED",     "DEADLINE",     "FAILED",
-      "NODE_FAIL", "PREEMPTED", "OUT_OF_MEMORY", "SPECIAL_EXIT", "TIMEOUT"};
-  return states;
-}
+// srun's own messages kept for an error (its last lines say why it ended).
+constexpr std::size_t kMaxSrunOutput = 8192;
 
 std::string trimmed(std::string text) {
   while (!text.empty() && (text.back() == '\n' || text.back() == ' ' || text.back() == '\r')) {
@@ -38,11 +31,11 @@ std::string trimmed(std::string text) {
   return start == std::string::npos ? std::string() : text.substr(start);
 }
 
-// 'text' quoted for sh: inside single quotes, a quote as '\''.
-std::string shell_quoted(const std::string& text) {
-  std::string out = "'";
-  for (const char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
+// srun's messages on one line, for an error text.
+std::string one_line(const std::string& text) {
+  std::string line;
+  for (const char c : trimmed(text)) line += c == '\n' ? std::string(" | ") : std::string(1, c);
+  return line;
 }
 
 bool is_file(const fs::path& path) {
@@ -59,22 +52,27 @@ Completion failed(const Job& job, std::string error, Clock::time_point start) {
 
 }  // namespace
 
-std::map<std::string, std::string> slurm_job_fields(const std::string& job_id) {
-  std::map<std::string, std::string> fields;
-  process::CommandResult shown;
+std::optional<SlurmJobState> find_slurm_job(const std::string& name, const std::string& comment) {
+  process::CommandResult listed;
   try {
-    shown = process::run_command({"scontrol", "show", "job", "-o", job_id});
+    listed = process::run_command(
+        {"squeue", "--noheader", "--states=all", "--name=" + name, "--format=%i|%T|%r|%k"},
+        {.max_output = std::size_t{1} << 20U});
   } catch (const IoError&) {
-    return fields;
+    return std::nullopt;
   }
-  if (shown.exit_code != 0) return fields;
-  std::istringstream words(shown.output);
-  std::string word;
-  while (words >> word) {
-    const std::size_t equals = word.find('=');
-    if (equals != std::string::npos) fields[word.substr(0, equals)] = word.substr(equals + 1);
+  if (listed.exit_code != 0) return std::nullopt;
+  std::istringstream lines(listed.output);
+  std::string line;
+  std::optional<SlurmJobState> found;
+  while (std::getline(lines, line)) {
+    std::array<std::string, 4> fields;
+    std::istringstream cells(line);
+    for (std::string& field : fields) std::getline(cells, field, '|');
+    // The newest job of that name and comment: a re-run reuses the folder.
+    if (fields[3] == comment) found = SlurmJobState{fields[0], fields[1], fields[2]};
   }
-  return fields;
+  return found;
 }
 
 Completion execute_on_slurm(const Job& job, const fs::path& artifacts,
@@ -86,66 +84,45 @@ Completion execute_on_slurm(const Job& job, const fs::path& artifacts,
   const fs::path request_file = dir / "request.json";
   const fs::path result_file = dir / "result.json";
   const fs::path log_file = dir / "slurm.log";
-  std::string job_id;
+  const std::string job_name = "mmm-" + job.node;
+  process::CommandResult srun;
   try {
     std::error_code ignored;
     fs::remove_all(dir, ignored);
     fs::create_directories(dir);
     NodeRequest request{job, fs::absolute(artifacts), pool, dir / "work", result_file};
     write_file_atomically(request_file, node_request_text(request), "a node request");
-    const fs::path script = dir / "job.sh";
-    write_file_atomically(script,
-                          "#!/bin/sh\nexec " + shell_quoted(options.executable.string()) +
-                              " worker run-node " + shell_quoted(request_file.string()) + "\n",
-                          "a job script");
     const NodeResources& resources = job.type->spec.resources();
-    std::vector<std::string> sbatch = {"sbatch",
-                                       "--parsable",
-                                       "--job-name=mmm-" + job.node,
-                                       "--output=" + log_file.string(),
-                                       "--chdir=" + dir.string(),
-                                       "--cpus-per-task=" + std::to_string(resources.threads),
-                                       "--mem=" + std::to_string(resources.memory_mb) + "M"};
-    sbatch.insert(sbatch.end(), options.sbatch_arguments.begin(), options.sbatch_arguments.end());
-    sbatch.push_back(script.string());
-    const process::CommandResult submitted = process::run_command(sbatch);
-    job_id = trimmed(submitted.output.substr(0, submitted.output.find(';')));
-    if (submitted.exit_code != 0 || job_id.empty() ||
-        !std::all_of(job_id.begin(), job_id.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-      return failed(job,
-                    "sbatch refused node '" + job.node + "': " + trimmed(submitted.output) +
-                        "; hint: check the cluster (sinfo) and SLURM_CONF",
-                    start);
+    // The comment (the job's folder) tells this job from any other of the
+    // same name when Slurm is asked about it afterwards.
+    std::vector<std::string> command = {"srun",
+                                        "--job-name=" + job_name,
+                                        "--comment=" + dir.string(),
+                                        "--nodes=1",
+                                        "--ntasks=1",
+                                        "--cpus-per-task=" + std::to_string(resources.threads),
+                                        "--mem=" + std::to_string(resources.memory_mb) + "M",
+                                        "--input=none",
+                                        "--output=" + log_file.string(),
+                                        "--chdir=" + dir.string()};
+    command.insert(command.end(), options.srun_arguments.begin(), options.srun_arguments.end());
+    command.insert(command.end(),
+                   {options.executable.string(), "worker", "run-node", request_file.string()});
+    if (observer != nullptr) {
+      observer->node_log(job.node, LogLevel::kInfo,
+                         "submitted to Slurm (srun, job " + job_name + ")");
     }
+    srun = process::run_command(command,
+                                {.max_output = kMaxSrunOutput, .parent_death_signal = SIGTERM});
   } catch (const std::exception& error) {
-    return failed(
-        job, std::string("cannot submit node '") + job.node + "' to Slurm: " + error.what(), start);
+    return failed(job,
+                  std::string("cannot submit node '") + job.node + "' to Slurm: " + error.what() +
+                      "; hint: is Slurm's srun installed here, and SLURM_CONF set?",
+                  start);
   }
-  if (observer != nullptr) {
-    observer->node_log(job.node, LogLevel::kInfo, "submitted as Slurm job " + job_id);
-  }
-  // Follow the job until squeue no longer lists it as queued or running.
-  auto pause = std::chrono::milliseconds(20);
-  while (true) {
-    std::this_thread::sleep_for(pause);
-    pause = std::min(pause * 2, options.poll);
-    process::CommandResult queued;
-    try {
-      queued = process::run_command({"squeue", "-h", "-j", job_id, "-o", "%T"});
-    } catch (const std::exception& error) {
-      return failed(job, std::string("cannot follow Slurm job ") + job_id + ": " + error.what(),
-                    start);
-    }
-    const std::string state = trimmed(queued.output);
-    // Gone from the queue (or unknown to it), finished, or completing (the
-    // script has ended; Slurm is cleaning up): nothing more will come.
-    if (queued.exit_code != 0 || state.empty() || state == "COMPLETING" ||
-        final_states().contains(state)) {
-      break;
-    }
-    // The worker's result is written atomically, as its last act.
-    if (is_file(result_file)) break;
-  }
+  const std::optional<SlurmJobState> slurm_job = find_slurm_job(job_name, dir.string());
+  const std::string job_id = slurm_job ? slurm_job->id : std::string("(unknown id)");
+  // The worker's result is written atomically, as its last act.
   if (is_file(result_file)) {
     try {
       const std::uintmax_t size = fs::file_size(result_file);
@@ -164,17 +141,12 @@ Completion execute_on_slurm(const Job& job, const fs::path& artifacts,
           start);
     }
   }
-  const std::map<std::string, std::string> fields = slurm_job_fields(job_id);
-  const auto value = [&fields](const char* key) {
-    const auto it = fields.find(key);
-    return it == fields.end() ? std::string("unknown") : it->second;
-  };
-  return failed(job,
-                "Slurm job " + job_id + " of node '" + job.node + "' ended " + value("JobState") +
-                    " (reason " + value("Reason") + ", exit code " + value("ExitCode") +
-                    ") without a result; its output: " + log_file.string() +
-                    "; hint: the next run submits it again",
-                start);
+  std::string error = "Slurm job " + job_id + " of node '" + job.node + "' ended";
+  if (slurm_job) error += " " + slurm_job->state + " (reason " + slurm_job->reason + ")";
+  error += " without a result (srun exit code " + std::to_string(srun.exit_code) + ": " +
+           one_line(srun.output) + "); the job's output: " + log_file.string() +
+           "; hint: the next run submits it again";
+  return failed(job, std::move(error), start);
 }
 
 }  // namespace mmm::workflow
