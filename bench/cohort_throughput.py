@@ -11,12 +11,13 @@ difference per node execution between the two executors.
 
 Usage: cohort_throughput.py --mmm MMM --source REPO --atlas ATLAS --data DATA
        --work DIR [--patients 20] [--end-time SECONDS] [--executors local,slurm]
-       [--out FILE]
+       [--jobs 2] [--out FILE]
 """
 
 import argparse
 import csv
 import json
+import re
 import os
 import shutil
 import sqlite3
@@ -45,14 +46,21 @@ def utc_seconds(text):
     return datetime.fromisoformat(text.replace("Z", "+00:00")).timestamp()
 
 
+SLURM_LINE = re.compile(r"ran as Slurm job \S+: ([0-9.]+) s on the node, ([0-9.]+) s more in Slurm")
+
+
 def study_figures(study):
-    """(seconds of all its runs, node executions done) from the study's database."""
+    """(seconds of all its runs, node executions done, Slurm's seconds per
+    node execution) from the study's database."""
     db = sqlite3.connect(f"file:{study / 'study.db'}?mode=ro", uri=True)
     seconds = sum(utc_seconds(b) - utc_seconds(a) for a, b in db.execute(
         "SELECT started_at, finished_at FROM runs WHERE finished_at IS NOT NULL"))
     done = db.execute("SELECT COUNT(*) FROM executions WHERE status = 'done'").fetchone()[0]
+    in_slurm = [float(m.group(2)) for (message,) in db.execute(
+        "SELECT message FROM logs WHERE message LIKE 'ran as Slurm job %'")
+        if (m := SLURM_LINE.match(message))]
     db.close()
-    return seconds, done
+    return seconds, done, in_slurm
 
 
 def one_cohort(args, executor, patients_csv, patients, env):
@@ -64,9 +72,9 @@ def one_cohort(args, executor, patients_csv, patients, env):
     if args.end_time is not None:
         for pid in patients:
             run([args.mmm, "study", "set", root / pid, f"motion.end_time={args.end_time}"], env)
-    flags = ["-j", "2"]
+    flags = ["-j", str(args.jobs)]
     if executor == "slurm":
-        flags += ["--executor", "slurm", "--node-jobs", "2"]
+        flags += ["--executor", "slurm", "--node-jobs", str(args.jobs)]
 
     start = time.monotonic()
     run([args.mmm, "cohort", "run", root, *flags], env, expect=(3,))
@@ -97,17 +105,25 @@ def one_cohort(args, executor, patients_csv, patients, env):
     if status["counts"] != {"done": len(patients)}:
         fail(f"{executor}: the cohort did not finish: {status['counts']}")
 
-    per_patient, nodes = [], 0
+    per_patient, nodes, in_slurm = [], 0, []
     for pid in patients:
-        seconds, done = study_figures(root / pid)
+        seconds, done, extra = study_figures(root / pid)
         per_patient.append(seconds)
         nodes += done
+        in_slurm += extra
+    # Every node execution but the manual ones (tasks, not jobs) is a job.
+    if executor == "slurm" and not in_slurm:
+        fail("no node execution ran as a Slurm job")
     return {"executor": executor, "patients": len(patients), "wall_seconds": to_station + to_end,
             "to_station_seconds": to_station, "to_end_seconds": to_end,
             "operator_seconds": operator, "node_executions": nodes,
             "per_patient_median_seconds": statistics.median(per_patient),
             "per_patient_max_seconds": max(per_patient),
-            "per_patient_sum_seconds": sum(per_patient)}
+            "per_patient_sum_seconds": sum(per_patient),
+            "slurm_jobs": len(in_slurm),
+            "slurm_seconds_per_node_median": statistics.median(in_slurm) if in_slurm else None,
+            "slurm_seconds_per_node_p90": (statistics.quantiles(in_slurm, n=10)[-1]
+                                           if len(in_slurm) > 1 else None)}
 
 
 def main():
@@ -118,13 +134,17 @@ def main():
     parser.add_argument("--end-time", type=float, default=None,
                         help="the walk's end (s); default: the workflow's (the whole walk)")
     parser.add_argument("--executors", default="local,slurm")
+    parser.add_argument("--jobs", type=int, default=2,
+                        help="studies at once, and Slurm jobs out at once per study")
     parser.add_argument("--out", type=Path)
     args = parser.parse_args()
     for name in ("mmm", "source", "atlas", "data", "work"):
         setattr(args, name, getattr(args, name).resolve())
-    if args.work.exists():
-        shutil.rmtree(args.work)
-    args.work.mkdir(parents=True)
+    # Patients already made there are kept (they depend only on the atlas
+    # and the seed); the cohorts are made afresh.
+    args.work.mkdir(parents=True, exist_ok=True)
+    for executor in ("local", "slurm", "cluster"):
+        shutil.rmtree(args.work / executor, ignore_errors=True)
 
     patients = {}
     with open(args.work / "patients.csv", "w", newline="") as out:
@@ -133,8 +153,10 @@ def main():
         for i in range(1, args.patients + 1):
             pid = f"p{i:03d}"
             folder = args.work / "patients" / pid
-            run([args.mmm, "patient", "synth", "--atlas", args.atlas, "--seed", 100 + i,
-                 "-o", folder])
+            if not (folder / "ground_truth.json").is_file():
+                shutil.rmtree(folder, ignore_errors=True)
+                run([args.mmm, "patient", "synth", "--atlas", args.atlas, "--seed", 100 + i,
+                     "-o", folder])
             patients[pid] = folder
             r = folder / "radiographs"
             writer.writerow([pid, pid.upper(), r / "views.json", r / "frontal.png",
@@ -157,19 +179,28 @@ def main():
         finally:
             if executor == "slurm":
                 subprocess.run([str(script), "stop", str(cluster)], check=False)
+        # About 1 GB per study (wrapped muscles and fibres per frame): only
+        # the figures are kept.
+        shutil.rmtree(args.work / executor, ignore_errors=True)
         r = results[-1]
         print(f"{executor}: {r['patients']} patients, {r['node_executions']} node executions: "
               f"wall {r['wall_seconds']:.0f} s (to the station {r['to_station_seconds']:.0f} s, "
               f"to the end {r['to_end_seconds']:.0f} s; operator {r['operator_seconds']:.0f} s "
               f"apart); per patient median {r['per_patient_median_seconds']:.1f} s, max "
               f"{r['per_patient_max_seconds']:.1f} s", flush=True)
+        if r["slurm_seconds_per_node_median"] is not None:
+            print(f"  per node execution, time in Slurm beyond the node's own (waiting for free "
+                  f"CPUs, allocation, start, end): median "
+                  f"{r['slurm_seconds_per_node_median']:.2f} s, 90th percentile "
+                  f"{r['slurm_seconds_per_node_p90']:.2f} s", flush=True)
     if len(results) == 2:
         local, slurm = results
         extra = (slurm["wall_seconds"] - local["wall_seconds"]) / slurm["node_executions"]
         print(f"slurm against local: wall x{slurm['wall_seconds'] / local['wall_seconds']:.3f}, "
               f"{extra:+.2f} s of wall time per node execution")
     if args.out:
-        args.out.write_text(json.dumps({"end_time": args.end_time, "results": results}, indent=2))
+        args.out.write_text(json.dumps({"end_time": args.end_time, "jobs": args.jobs,
+                                        "results": results}, indent=2))
 
 
 if __name__ == "__main__":

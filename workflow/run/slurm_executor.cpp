@@ -2,8 +2,10 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <array>
 #include <csignal>
+#include <iomanip>
 #include <sstream>
 
 #include "core/errors.h"
@@ -127,9 +129,16 @@ Completion execute_on_slurm(const Job& job, const fs::path& artifacts,
     try {
       const std::uintmax_t size = fs::file_size(result_file);
       Completion completion = completion_from_text(read_file_bytes(result_file, size), result_file);
-      completion.logs.insert(completion.logs.begin(),
-                             {utc_now_precise(), LogLevel::kInfo, "ran as Slurm job " + job_id});
+      const double on_node = completion.seconds;
       completion.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+      // What Slurm added: waiting for the allocation, starting the worker,
+      // ending the job (the node's own time is the worker's).
+      std::ostringstream line;
+      line << std::fixed << std::setprecision(3) << "ran as Slurm job " << job_id << ": " << on_node
+           << " s on the node, " << std::max(0.0, completion.seconds - on_node)
+           << " s more in Slurm (queued, started, ended)";
+      completion.logs.insert(completion.logs.begin(),
+                             {utc_now_precise(), LogLevel::kInfo, line.str()});
       if (completion.error.empty()) {
         std::error_code ignored;
         fs::remove_all(dir, ignored);
