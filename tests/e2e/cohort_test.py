@@ -15,7 +15,9 @@ tests/e2e/cohort_workflow.yaml (landmarks, scaling, outline fitting):
   5. `cohort run -j 2` again: both studies done. Nothing that had finished
      before the kill ran again (one 'done' execution per cache key), and
      what was killed is recorded as interrupted and ran again.
-  6. `mmm gc ROOT` finds nothing to remove; the outputs are intact.
+  6. `mmm gc ROOT --apply` removes only blobs no study's database mentions
+     (what the kill left) and every study stays whole: a further run
+     executes nothing.
   7. `mmm cohort report ROOT`: both studies done, their contour residuals,
      the operator's landmark errors.
 
@@ -59,6 +61,23 @@ def executions(study):
     rows = db.execute("SELECT node, cache_key, status FROM executions").fetchall()
     db.close()
     return rows
+
+
+def blob_files(root):
+    """Every artifact file under the root: the studies' and the shared store's."""
+    found = set()
+    for store in [root / ".mmm-store", *(d / "artifacts" for d in root.iterdir() if d.is_dir())]:
+        if store.is_dir():
+            found.update(p for p in store.glob("??/*") if len(p.parent.name + p.name) == 64)
+    return found
+
+
+def database_text(study):
+    """The whole study database as SQL text (every table, every value)."""
+    db = sqlite3.connect(f"file:{study / 'study.db'}?mode=ro", uri=True)
+    text = "\n".join(db.iterdump())
+    db.close()
+    return text
 
 
 def live_runs(root):
@@ -178,11 +197,27 @@ def main():
     if interrupted == 0:
         fail("the kill interrupted no execution (the test did not test a kill)")
 
-    # 6. Nothing to collect.
-    report = json.loads(run([args.mmm, "gc", root, "--json", "--grace-minutes", "0"],
-                            log).stdout)
-    if report["study_blobs"] or report["shared_blobs"]:
-        fail(f"gc would remove referenced blobs: {report}")
+    # 6. Collected. What gc finds can only be what the kill left: outputs a
+    # node had stored when the kill came before its record was committed,
+    # which its re-run wrote again with other bytes (a fit's time, say).
+    # Whatever it removes must be mentioned in no study's database, and every
+    # study must stay whole: a further run finds nothing to do.
+    blobs_before = blob_files(root)
+    report = json.loads(run([args.mmm, "gc", root, "--json", "--grace-minutes", "0",
+                             "--apply"], log).stdout)
+    removed = blobs_before - blob_files(root)
+    if len(removed) != report["study_blobs"] + report["shared_blobs"]:
+        fail(f"gc reported {report} but removed {len(removed)} files")
+    for pid in patients:
+        mentioned = database_text(root / pid)
+        for path in removed:
+            if path.parent.name + path.name in mentioned:
+                fail(f"gc removed {path}, which {pid}'s database mentions")
+    before_rerun = {pid: executions(root / pid) for pid in patients}
+    run([args.mmm, "cohort", "run", root, "-j", "2"], log)
+    for pid in patients:
+        if executions(root / pid) != before_rerun[pid]:
+            fail(f"{pid}: a run after gc executed nodes again (a blob it needed is gone)")
     # 7. The cohort's report.
     run([args.mmm, "cohort", "report", root], log)
     page = (root / "cohort_report" / "index.html").read_text()
@@ -193,7 +228,8 @@ def main():
 
     print(f"cohort: 2 studies done after a SIGKILL of the coordinator ({interrupted} interrupted "
           f"execution(s) re-run, nothing finished redone); "
-          f"{report['kept_bytes'] >> 20} MB under the root, nothing to collect")
+          f"{report['kept_bytes'] >> 20} MB under the root, {len(removed)} unreferenced "
+          f"file(s) collected")
 
 
 if __name__ == "__main__":
