@@ -356,11 +356,8 @@ CohortReportResult write_cohort_report(const fs::path& root, const fs::path& out
 
   const std::string title = "Cohort " + fs::absolute(root).lexically_normal().filename().string();
   const std::string page =
-      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" +
-      xml_escaped(title) + "</title>\n<style>" + std::string(report_style()) +
-      "</style>\n</head>\n<body>\n<h1>" + xml_escaped(title) + "</h1>\n<p>" +
-      std::to_string(studies.size()) + " studies, written " + workflow::utc_now() +
-      " by mmm.</p>\n" + body + "</body>\n</html>\n";
+      html_page(title, "<p>" + std::to_string(studies.size()) + " studies, written " +
+                           workflow::utc_now() + " by mmm.</p>\n" + body);
   result.index = out / "index.html";
   write_file_atomically(result.index, page, "the cohort report");
   return result;

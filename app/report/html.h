@@ -3,7 +3,6 @@
 // scripts, no external resources.
 
 #include <string>
-#include <string_view>
 #include <vector>
 
 namespace mmm::app::report {
@@ -12,8 +11,9 @@ namespace mmm::app::report {
 std::string html_table(const std::vector<std::string>& header,
                        const std::vector<std::vector<std::string>>& rows);
 
-// The pages' shared style sheet (a <style> element's content).
-std::string_view report_style();
+// A whole page: the document head with the reports' shared style sheet, the
+// title as its <h1>, then `body` (HTML as it is).
+std::string html_page(const std::string& title, const std::string& body);
 
 // A number with `decimals` digits after the point ("-" for NaN or infinity).
 std::string fixed(double value, int decimals);

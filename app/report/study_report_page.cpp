@@ -460,14 +460,9 @@ ReportResult write_study_report(const ReportInput& input, const fs::path& out) {
   provenance_section(page, input.status);
   const fs::path study_dir = input.status.value("study", std::string());
   const std::string title = "mmm study report: " + study_dir.filename().string();
-  const std::string html =
-      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-      "<title>" +
-      xml_escaped(title) + "</title>\n<style>" + std::string(report_style()) +
-      "</style>\n</head>\n<body>\n<h1>" + xml_escaped(title) +
-      "</h1>\n<p>State: " + xml_escaped(input.status.value("state", std::string())) +
-      ". Study folder: " + xml_escaped(study_dir.string()) + "</p>\n" + page.body() +
-      "</body>\n</html>\n";
+  const std::string html = html_page(
+      title, "<p>State: " + xml_escaped(input.status.value("state", std::string())) +
+                 ". Study folder: " + xml_escaped(study_dir.string()) + "</p>\n" + page.body());
   ReportResult result{out / "index.html", page.figures(), page.pending_sections()};
   const fs::path partial = out / "index.html.partial";
   {
